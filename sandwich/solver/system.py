@@ -1,0 +1,62 @@
+"""The contract between a discretised model and the path-following solver.
+
+A model exposes its equilibrium equations on the *free* unknowns ``u`` (supports and exact ties
+already eliminated) as
+
+    R(u, λ) = f_int(u) − λ f_ref = 0,
+
+with ``f_ref`` the reference (dead) load of the scene and λ the load factor.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+
+class Factorization(Protocol):
+    """A factorised tangent: solves with it, and its inertia if the backend knows it."""
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Return ``K⁻¹ b``."""
+        ...
+
+    @property
+    def negative_pivots(self) -> int | None:
+        """Number of negative eigenvalues of ``K`` (Sylvester), or ``None`` if unknown."""
+        ...
+
+
+class DiscreteSystem(Protocol):
+    """Equilibrium equations of a model, as the solver sees them."""
+
+    @property
+    def size(self) -> int:
+        """Number of free unknowns."""
+        ...
+
+    @property
+    def f_ref(self) -> np.ndarray:
+        """Reference external load on the free unknowns (multiplied by λ)."""
+        ...
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        """Return f_int(u) (including contact forces), shape ``(size,)``."""
+        ...
+
+    def tangent(self, u: np.ndarray) -> object:
+        """Return ∂f_int/∂u at ``u`` in whatever form :meth:`factorize` accepts."""
+        ...
+
+    def factorize(self, K: object) -> Factorization:
+        """Factorise a tangent returned by :meth:`tangent`."""
+        ...
+
+    def probe_vector(self, name: str) -> np.ndarray:
+        """Return ``c`` with probe value ``c · u`` (probes are linear in ``u``)."""
+        ...
+
+    def commit(self, u: np.ndarray, load_factor: float) -> None:
+        """Accept a converged state (update history variables such as contact status)."""
+        ...

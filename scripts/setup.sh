@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Install everything the project needs, idempotently: Debian's FEniCSx stack, then a venv that
+# sees it (--system-site-packages), then this package and its PyPI dependencies with numpy < 2.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+DEBS="python3-dolfinx-real python3-gmsh python3-meshio python3-scipy python3-matplotlib python3-venv python3-dev gcc"
+missing=""
+for p in $DEBS; do
+    dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+    echo "setup: installing Debian packages:$missing"
+    SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null
+fi
+
+if [ ! -x .venv/bin/python ]; then
+    echo "setup: creating .venv from /usr/bin/python3 with system site packages"
+    /usr/bin/python3 -m venv --system-site-packages .venv
+fi
+
+stamp=.venv/.installed
+if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ constraints.txt -nt "$stamp" ]; then
+    echo "setup: installing the project into .venv"
+    .venv/bin/python -m pip install -q --upgrade pip >/dev/null
+    .venv/bin/python -m pip install -q -c constraints.txt -e ".[dev,viz]"
+    touch "$stamp"
+fi
