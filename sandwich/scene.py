@@ -1,0 +1,247 @@
+"""Scene files (TOML): the typed scene every model consumes, and its loader.
+
+A scene describes one problem — geometry, materials, debonds, supports, loads, analysis, probes —
+in N, mm and MPa. :func:`load_scene` parses and validates it; every problem found is reported at
+once as a :class:`SceneError` that names the file, the key and the reason. The checks themselves
+live in :mod:`sandwich.scene_checks`.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+FACES = ("top", "bottom")
+INTERFACES = ("top", "bottom")
+SUPPORT_SITES = ("top", "bottom", "faces")
+SUPPORT_TYPES = ("pin", "roller", "clamp")
+ANALYSIS_KINDS = ("linear", "nonlinear")
+CONTROLS = ("load", "displacement", "arc-length")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong with a scene: where (file, key) and why."""
+
+    file: str
+    key: str
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.file}: {self.key}: {self.reason}"
+
+
+class SceneError(ValueError):
+    """A scene that cannot be used; ``problems`` lists every reason found."""
+
+    def __init__(self, problems: list[Problem]):
+        self.problems = problems
+        super().__init__("\n".join(str(p) for p in problems))
+
+
+@dataclass(frozen=True)
+class Material:
+    """Plane-stress linear elastic material (eqs. 3-4, 27).
+
+    An isotropic material is stored as Ex = Ez = E, Gzx = E / (2 (1 + nu)), nu_zx = nu.
+    """
+
+    name: str
+    kind: str  # "isotropic" | "orthotropic"
+    Ex: float  # MPa
+    Ez: float  # MPa
+    Gzx: float  # MPa
+    nu_zx: float  # contraction in x for extension in z
+
+    @property
+    def D(self) -> float:
+        """Denominator of eq. (4): 1 − (Ex/Ez) ν_zx²."""
+        return 1.0 - (self.Ex / self.Ez) * self.nu_zx**2
+
+    @property
+    def Qx(self) -> float:
+        """Plane-stress stiffness Q_x = Ex / D, eq. (4) (MPa)."""
+        return self.Ex / self.D
+
+    @property
+    def Qz(self) -> float:
+        """Plane-stress stiffness Q_z = Ez / D, eq. (4) (MPa)."""
+        return self.Ez / self.D
+
+    @property
+    def Q(self) -> float:
+        """Coupling stiffness Q = Ex ν_zx / D, eq. (4) (MPa)."""
+        return self.Ex * self.nu_zx / self.D
+
+
+@dataclass(frozen=True)
+class Layer:
+    """A face or the core: thickness (mm) and material."""
+
+    thickness: float
+    material: Material
+
+
+@dataclass(frozen=True)
+class Debond:
+    """A debonded stretch [start, end] (mm) of the top or bottom face/core interface."""
+
+    interface: str
+    start: float
+    end: float
+
+    @property
+    def length(self) -> float:
+        """Length of the debond (mm); zero is allowed and means bonded."""
+        return self.end - self.start
+
+
+@dataclass(frozen=True)
+class Support:
+    """A support at station x acting on one face or both ("faces")."""
+
+    x: float
+    on: str
+    type: str
+
+    @property
+    def faces(self) -> tuple[str, ...]:
+        """The faces this support acts on."""
+        return FACES if self.on == "faces" else (self.on,)
+
+
+@dataclass(frozen=True)
+class Load:
+    """A dead transverse load on a face: point load (width 0) or uniform patch, total force in N."""
+
+    on: str
+    x: float
+    width: float
+    force: float
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The stretch [x − width/2, x + width/2] the load covers (mm)."""
+        return (self.x - 0.5 * self.width, self.x + 0.5 * self.width)
+
+
+@dataclass(frozen=True)
+class Probe:
+    """Transverse displacement w of a face at station x, recorded at every step (mm)."""
+
+    name: str
+    on: str
+    x: float
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """What to solve and how far: the load factor λ multiplies every load's force."""
+
+    kind: str = "nonlinear"
+    control: str = "load"
+    until_probe: str | None = None
+    until_value: float | None = None
+    until_load_factor: float | None = None
+    max_steps: int = 200
+    initial_increment: float | None = None
+    min_increment: float | None = None
+    max_increment: float | None = None
+    tol: float = 1e-8
+    max_iterations: int = 25
+
+
+@dataclass(frozen=True)
+class BeamModelOptions:
+    """Resolution and numerics of the beam element model (table ``[beam_model]``)."""
+
+    elements: int = 120
+    gauss_x: int = 4
+    gauss_z: int = 4
+    contact_penalty: float | None = None
+    profile_every: int = 0  # 0: profiles at the last step only
+
+
+@dataclass(frozen=True)
+class Reference2DOptions:
+    """Resolution and numerics of the 2D reference (table ``[reference2d]``)."""
+
+    level: str = "medium"  # "coarse" | "medium" | "fine" | "explicit"
+    refine: int = 0  # uniform refinement count on top of the level (each halves sizes)
+    face_elements: int = 2  # quadratic elements through each face thickness
+    core_size: float | None = None  # explicit element size in the core (mm), level "explicit"
+    face_size: float | None = None  # explicit element length along the faces (mm)
+    tip_size: float | None = None  # element size at crack tips / loads / supports (mm)
+    half_model: bool = False
+    contact_penalty: float | None = None
+    profile_every: int = 0
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One problem, the single source of truth for every model."""
+
+    name: str
+    description: str
+    length: float
+    width: float
+    top: Layer
+    core: Layer
+    bottom: Layer
+    debonds: tuple[Debond, ...]
+    supports: tuple[Support, ...]
+    loads: tuple[Load, ...]
+    probes: tuple[Probe, ...]
+    analysis: Analysis
+    beam_model: BeamModelOptions = field(default_factory=BeamModelOptions)
+    reference2d: Reference2DOptions = field(default_factory=Reference2DOptions)
+    source: Path | None = None
+
+    @property
+    def total_height(self) -> float:
+        """Face + core + face thickness (mm)."""
+        return self.top.thickness + self.core.thickness + self.bottom.thickness
+
+    def layer(self, name: str) -> Layer:
+        """The layer called ``name`` ("top", "core" or "bottom")."""
+        return {"top": self.top, "core": self.core, "bottom": self.bottom}[name]
+
+    def debonds_on(self, interface: str) -> tuple[Debond, ...]:
+        """The debonds of one interface, sorted by start."""
+        return tuple(sorted((d for d in self.debonds if d.interface == interface),
+                            key=lambda d: d.start))
+
+    def is_bonded(self, interface: str, x: float, tol: float = 1e-9) -> bool:
+        """Whether ``x`` is bonded on ``interface`` (debond tips count as bonded)."""
+        return not any(d.start + tol < x < d.end - tol for d in self.debonds_on(interface))
+
+    def probe(self, name: str) -> Probe:
+        """The probe called ``name``."""
+        for p in self.probes:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read, check and return the scene in ``path``; raise :class:`SceneError` if it is bad."""
+    from sandwich.scene_checks import build_scene
+
+    path = Path(path)
+    fname = str(path)
+    if not path.is_file():
+        raise SceneError([Problem(fname, "-", "no such file")])
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise SceneError([Problem(fname, "-", f"not UTF-8 text ({exc.reason})")]) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError([Problem(fname, "-", f"not valid TOML: {exc}")]) from None
+    return build_scene(data, fname, source=path)
+
+
+def is_finite_number(value: object) -> bool:
+    """True for an int or float (not bool) that is finite."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
