@@ -140,7 +140,8 @@ def profiles_csv(solution: Solution) -> str:
     for p in solution.profiles:
         n = len(p.columns["x"])
         for i in range(n):
-            rows.append([p.step, *(_cell(float(p.columns[c][i])) if c in p.columns else "" for c in names)])
+            rows.append([p.step, *(_cell(float(p.columns[c][i])) if c in p.columns else ""
+                                   for c in names)])
     return _csv_text(["step", *names], rows)
 
 

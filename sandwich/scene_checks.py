@@ -58,7 +58,8 @@ class Reader:
         for k in value:
             if k not in allowed:
                 near = difflib.get_close_matches(k, allowed, n=1, cutoff=0.6)
-                hint = f" (did you mean '{near[0]}'?)" if near else f" (allowed: {', '.join(allowed)})"
+                hint = (f" (did you mean '{near[0]}'?)" if near
+                        else f" (allowed: {', '.join(allowed)})")
                 self.fail(_join(key, k), f"unknown key{hint}")
         for k in required:
             if k not in value:
