@@ -3,6 +3,30 @@
 The solver never knows which physics it drives: it sees a :class:`DiscreteSystem`.
 """
 
+from sandwich.solver.newton import NewtonResult, NewtonSettings, newton_correct, solve_equilibrium
+from sandwich.solver.path import PathOptions, PathResult, PathState, follow_path, solve_linear
+from sandwich.solver.sparse import (
+    SingularTangentError,
+    SparseFactorization,
+    SparseSystemMixin,
+    factorize_symmetric,
+)
 from sandwich.solver.system import DiscreteSystem, Factorization
 
-__all__ = ["DiscreteSystem", "Factorization"]
+__all__ = [
+    "DiscreteSystem",
+    "Factorization",
+    "NewtonResult",
+    "NewtonSettings",
+    "PathOptions",
+    "PathResult",
+    "PathState",
+    "SingularTangentError",
+    "SparseFactorization",
+    "SparseSystemMixin",
+    "factorize_symmetric",
+    "follow_path",
+    "newton_correct",
+    "solve_equilibrium",
+    "solve_linear",
+]

@@ -1,0 +1,62 @@
+"""Limit points and bifurcations read off a computed equilibrium path.
+
+- A *limit point* is a converged state where λ has a local extremum along the path: the
+  increments Δλ before and after it have opposite signs (zero increments are skipped). It is
+  reported at that state (so its load factor is exact only to the step resolution).
+- A *bifurcation* is a change of the tangent's negative-pivot count between two successive states
+  that is not explained by a limit point: a simple limit point changes the count by one between
+  the state before and the state after it; any further change (or a change with no limit point
+  next to it) is reported at the first state with the new count.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Protocol
+
+import numpy as np
+
+from sandwich.results import LimitPoint
+
+__all__ = ["find_limit_points"]
+
+
+class _State(Protocol):
+    step: int
+    load_factor: float
+    probes: dict[str, float]
+    negative_pivots: int | None
+
+
+def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
+    """Return the limit points and bifurcations along ``states`` (ordered by step)."""
+    n = len(states)
+    if n < 2:
+        return []
+    lam = np.array([s.load_factor for s in states], dtype=float)
+    dlam = np.diff(lam)
+    found: list[LimitPoint] = []
+    limit_at: set[int] = set()
+    nz = np.flatnonzero(dlam != 0.0)  # increment j goes from state j to state j + 1
+    for j0, j1 in zip(nz[:-1], nz[1:], strict=True):
+        if np.sign(dlam[j0]) != np.sign(dlam[j1]):
+            k = int(j0) + 1  # the extreme state ends the first increment
+            kind = "max" if dlam[j0] > 0 else "min"
+            s = states[k]
+            found.append(LimitPoint(kind, s.step, float(s.load_factor), dict(s.probes)))
+            limit_at.add(k)
+    used: set[int] = set()
+    for k in range(1, n):
+        a, b = states[k - 1].negative_pivots, states[k].negative_pivots
+        if a is None or b is None or a == b:
+            continue
+        change = abs(b - a)
+        for m in (k - 1, k):  # a limit point at either end of this step explains one change
+            if change and m in limit_at and m not in used:
+                used.add(m)
+                change -= 1
+        if change:
+            s = states[k]
+            found.append(LimitPoint("bifurcation", s.step, float(s.load_factor), dict(s.probes)))
+    found.sort(key=lambda lp: lp.step)
+    return found

@@ -1,0 +1,174 @@
+"""Full Newton–Raphson corrector for R(u, λ) = f_int(u) − λ f_ref = 0 with one constraint.
+
+Convergence (both tests, checked after every correction; at least one correction is made):
+
+- residual: ``‖R‖ ≤ tol · max(‖λ f_ref‖, ‖f_int(u)‖, force_floor, tiny)``, where the caller's
+  ``force_floor`` (the path follower passes ``‖f_ref‖ · max|λ|`` over the converged states) keeps
+  the test meaningful where λ and f_int both pass through zero;
+- increment: ``‖(δu, ψ δλ)‖ ≤ √tol · max(‖(Δu, ψ Δλ)‖, ‖(u, ψ λ)‖)`` for the last correction,
+  with ``Δ`` the step increment from the last converged state and ψ the load-factor weight
+  (displacement per unit λ). Newton converges quadratically, so a last correction of relative
+  size √tol leaves an error of relative size ~tol: the two tests ask for the same accuracy.
+
+Divergence (reported as a failed :class:`NewtonResult`, never raised): a non-finite residual or
+iterate, a singular tangent, a constraint without solution, a residual grown by more than
+``divergence_factor`` over the first one, or ``max_iterations`` corrections without convergence.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sandwich.solver.controls import Constraint, LoadConstraint
+from sandwich.solver.sparse import SingularTangentError
+from sandwich.solver.system import DiscreteSystem, Factorization
+
+__all__ = ["NewtonResult", "NewtonSettings", "newton_correct", "solve_equilibrium"]
+
+_TINY = 1e-300
+
+#: Failures of a model evaluation that mean "this iterate is unusable", not a bug.
+RECOVERABLE_ERRORS: tuple[type[BaseException], ...] = (
+    SingularTangentError,
+    ArithmeticError,
+    np.linalg.LinAlgError,
+)
+
+
+@dataclass(frozen=True)
+class NewtonSettings:
+    """Tolerances of the corrector (see the module docstring for the tests they enter)."""
+
+    tol: float = 1e-8
+    max_iterations: int = 25
+    psi: float = 1.0
+    force_floor: float = 0.0
+    divergence_factor: float = 1e4
+
+
+@dataclass
+class NewtonResult:
+    """Outcome of one corrector run.
+
+    On success ``u``/``load_factor`` are the converged equilibrium and ``factorization`` the
+    factorised tangent there (its inertia is the state's). On failure they are the start values
+    and ``reason`` says why.
+    """
+
+    converged: bool
+    u: np.ndarray
+    load_factor: float
+    iterations: int
+    residual_norm: float
+    reason: str
+    factorization: Factorization | None = None
+
+
+def _norm(v: np.ndarray, lam: float, psi: float) -> float:
+    return math.sqrt(float(v @ v) + (psi * lam) ** 2)
+
+
+def newton_correct(
+    system: DiscreteSystem,
+    u: np.ndarray,
+    load_factor: float,
+    constraint: Constraint,
+    settings: NewtonSettings,
+    u_start: np.ndarray | None = None,
+    load_factor_start: float | None = None,
+) -> NewtonResult:
+    """Iterate from a predicted ``(u, λ)`` to an equilibrium satisfying ``constraint``.
+
+    Parameters
+    ----------
+    system
+        The model.
+    u, load_factor
+        The predictor (the start of the iterations).
+    constraint
+        The extra equation fixing λ (load, probe or arc-length control).
+    settings
+        Tolerances.
+    u_start, load_factor_start
+        Last converged state: the step increment ``Δ`` is counted from it (defaults: the
+        predictor itself, i.e. a zero increment).
+
+    Returns
+    -------
+    NewtonResult
+        Converged or not; ordinary divergence is reported, not raised.
+    """
+    f_ref = np.asarray(system.f_ref, dtype=float)
+    u0 = np.array(u, dtype=float) if u_start is None else np.asarray(u_start, dtype=float)
+    lam0 = float(load_factor) if load_factor_start is None else float(load_factor_start)
+    u = np.array(u, dtype=float)
+    lam = float(load_factor)
+    psi = settings.psi
+    tol_inc = math.sqrt(settings.tol)
+    r_first = None
+    last_step = None  # norm of the last correction
+    r_norm = math.inf
+
+    def fail(reason: str, its: int) -> NewtonResult:
+        return NewtonResult(False, u0.copy(), lam0, its, r_norm, reason)
+
+    with np.errstate(all="ignore"):
+        for it in range(settings.max_iterations + 1):
+            try:
+                f_int = np.asarray(system.internal_force(u), dtype=float)
+            except RECOVERABLE_ERRORS as exc:
+                return fail(f"internal force failed: {exc}", it)
+            res = f_int - lam * f_ref
+            r_norm = float(np.linalg.norm(res))
+            if not math.isfinite(r_norm):
+                return fail("non-finite residual", it)
+            scale = max(abs(lam) * float(np.linalg.norm(f_ref)), float(np.linalg.norm(f_int)),
+                        settings.force_floor, _TINY)
+            if last_step is not None:
+                inc_scale = max(_norm(u - u0, lam - lam0, psi), _norm(u, lam, psi))
+                if r_norm <= settings.tol * scale and last_step <= tol_inc * inc_scale:
+                    try:
+                        fac = system.factorize(system.tangent(u))
+                    except RECOVERABLE_ERRORS as exc:
+                        return fail(f"tangent at the converged state is singular: {exc}", it)
+                    return NewtonResult(True, u, lam, it, r_norm, "converged", fac)
+            if r_first is None:
+                r_first = max(r_norm, settings.tol * scale)
+            elif r_norm > settings.divergence_factor * r_first:
+                return fail(f"residual grew from {r_first:.3e} to {r_norm:.3e}", it)
+            if it == settings.max_iterations:
+                break
+            try:
+                fac = system.factorize(system.tangent(u))
+                du_r = np.asarray(fac.solve(-res), dtype=float)
+                du_f = np.asarray(fac.solve(f_ref), dtype=float)
+            except RECOVERABLE_ERRORS as exc:
+                return fail(f"singular tangent: {exc}", it)
+            dlam = constraint.delta_lambda(du_r, du_f, u, lam, u - u0, lam - lam0)
+            if dlam is None or not math.isfinite(dlam):
+                return fail("the control equation has no solution at this iterate", it)
+            du = du_r + dlam * du_f
+            if not np.all(np.isfinite(du)):
+                return fail("non-finite correction", it)
+            u = u + du
+            lam = lam + dlam
+            last_step = _norm(du, dlam, psi)
+    return fail(
+        f"no convergence in {settings.max_iterations} iterations (residual {r_norm:.3e})",
+        settings.max_iterations,
+    )
+
+
+def solve_equilibrium(
+    system: DiscreteSystem,
+    load_factor: float,
+    u0: np.ndarray | None = None,
+    settings: NewtonSettings | None = None,
+) -> NewtonResult:
+    """Newton–Raphson at fixed λ from ``u0`` (default zero), with no path following."""
+    u = np.zeros(system.size) if u0 is None else np.asarray(u0, dtype=float)
+    return newton_correct(system, u, load_factor, LoadConstraint(float(load_factor)),
+                          settings or NewtonSettings())

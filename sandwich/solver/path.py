@@ -1,0 +1,493 @@
+"""Path following of R(u, λ) = f_int(u) − λ f_ref = 0: load, displacement and arc-length control.
+
+Every step goes from the last converged state ``(u₀, λ₀)`` with the factorised tangent ``K₀``
+there and its load tangent ``t = K₀⁻¹ f_ref``:
+
+- predictor along the tangent, ``(Δu, Δλ) = Δλ (t, 1)``, with ``Δλ`` fixed by the control:
+  load ``Δλ = ±h``; displacement ``Δλ = ±h / (c·t)``; arc-length
+  ``Δλ = σ h / √(t·t + ψ²)``;
+- Newton corrector (:mod:`sandwich.solver.newton`) with the matching constraint
+  (:mod:`sandwich.solver.controls`); ``h`` is the step increment in the units of the control
+  (load factor, probe value, arc length);
+- acceptance guard against jumps to a distant branch: the predictor may not be longer than
+  ``max_predictor_growth`` × the previous step, and the corrector may not move farther than
+  ``max_correction_ratio`` × the predictor length from the predictor (norm ``‖(Δu, ψΔλ)‖``);
+- on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
+  on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
+  (it never grows after a cut step) and is clipped to [min_increment, max_increment].
+
+ψ (:attr:`PathOptions.arc_load_weight` × ``‖K(0)⁻¹ f_ref‖``) converts λ into displacement units,
+so in the linear range the λ and u parts of the arc weigh the same.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sandwich.results import LimitPoint
+from sandwich.solver.controls import ArcLengthConstraint, LoadConstraint, ProbeConstraint
+from sandwich.solver.limits import find_limit_points
+from sandwich.solver.newton import RECOVERABLE_ERRORS, NewtonSettings, newton_correct
+from sandwich.solver.system import DiscreteSystem, Factorization
+
+__all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linear"]
+
+CONTROLS = ("load", "displacement", "arc-length")
+
+
+@dataclass
+class PathOptions:
+    """How to follow the path and when to stop.
+
+    Attributes
+    ----------
+    control
+        ``"load"``, ``"displacement"`` (of :attr:`control_probe`) or ``"arc-length"``.
+    until_load_factor
+        Stop when λ reaches this value (hit exactly).
+    until_probe, until_value
+        Stop when this probe reaches this value (hit within :attr:`target_tol`).
+    max_steps
+        Largest number of steps after state 0.
+    initial_increment
+        First increment in the units of the control; ``None``: 1/20 of the target estimated with
+        the linear solution.
+    min_increment, max_increment
+        Bounds of the increment; ``None``: ``1e-4`` and ``10`` times the initial increment.
+    tol
+        Relative residual tolerance of Newton (the increment tolerance is ``√tol``).
+    max_iterations
+        Newton corrections allowed per step.
+    desired_iterations
+        Iteration count for which the increment is kept; fewer grow it, more shrink it.
+    control_probe
+        Probe driven under displacement control (default: :attr:`until_probe`).
+    arc_load_weight
+        ψ / ‖K(0)⁻¹ f_ref‖ in the arc-length norm (0: cylindrical arc).
+    max_correction_ratio, max_predictor_growth
+        Jump guards (see the module docstring).
+    target_tol
+        Relative tolerance on hitting ``until_value`` / ``until_load_factor`` by step cutting.
+    """
+
+    control: str = "load"
+    until_load_factor: float | None = None
+    until_probe: str | None = None
+    until_value: float | None = None
+    max_steps: int = 200
+    initial_increment: float | None = None
+    min_increment: float | None = None
+    max_increment: float | None = None
+    tol: float = 1e-8
+    max_iterations: int = 25
+    desired_iterations: int = 5
+    control_probe: str | None = None
+    arc_load_weight: float = 1.0
+    max_correction_ratio: float = 1.0
+    max_predictor_growth: float = 4.0
+    target_tol: float = 1e-6
+
+    def __post_init__(self) -> None:
+        if self.control not in CONTROLS:
+            raise ValueError(f"control must be one of {CONTROLS}, got {self.control!r}")
+        if (self.until_probe is None) != (self.until_value is None):
+            raise ValueError("until_probe and until_value go together")
+        if self.control == "displacement" and self.driven_probe is None:
+            raise ValueError("displacement control needs control_probe (or until_probe)")
+        if self.until_load_factor == 0.0:
+            raise ValueError("until_load_factor = 0 is the initial state")
+        if self.until_value == 0.0:
+            raise ValueError("until_value = 0 is the initial state")
+        if self.max_steps < 1 or self.max_iterations < 1 or self.desired_iterations < 1:
+            raise ValueError("max_steps, max_iterations and desired_iterations must be >= 1")
+
+    @property
+    def driven_probe(self) -> str | None:
+        """The probe driven under displacement control."""
+        return self.control_probe or self.until_probe
+
+
+@dataclass
+class PathState:
+    """A converged equilibrium state (step 0 is the unloaded state ``u = 0, λ = 0``)."""
+
+    step: int
+    u: np.ndarray
+    load_factor: float
+    iterations: int
+    probes: dict[str, float]
+    negative_pivots: int | None
+    cuts: int = 0
+
+
+@dataclass
+class PathResult:
+    """The computed path: every converged state, whether the target was reached, and why not."""
+
+    states: list[PathState]
+    reached_target: bool
+    message: str
+    limit_points: list[LimitPoint] = field(default_factory=list)
+
+
+def solve_linear(system: DiscreteSystem, load_factor: float) -> np.ndarray:
+    """Return the linear solution ``u = K(0)⁻¹ λ f_ref``."""
+    fac = system.factorize(system.tangent(np.zeros(system.size)))
+    return np.asarray(fac.solve(load_factor * np.asarray(system.f_ref, dtype=float)), dtype=float)
+
+
+@dataclass
+class _Trial:
+    """A converged step candidate."""
+
+    u: np.ndarray
+    load_factor: float
+    iterations: int
+    factorization: Factorization
+
+
+def _fmt_probes(probes: dict[str, float]) -> str:
+    return ", ".join(f"{k} = {v:.6g}" for k, v in probes.items())
+
+
+class _Follower:
+    """State machine of :func:`follow_path` (one instance per call)."""
+
+    def __init__(
+        self,
+        system: DiscreteSystem,
+        options: PathOptions,
+        probe_names: Sequence[str],
+        progress: Callable[[PathState], None] | None,
+    ) -> None:
+        self.system = system
+        self.opt = options
+        self.progress = progress
+        names = list(dict.fromkeys([*probe_names, *(n for n in (options.until_probe,
+                                                                 options.driven_probe) if n)]))
+        self.c = {n: np.asarray(system.probe_vector(n), dtype=float) for n in names}
+        self.f_ref = np.asarray(system.f_ref, dtype=float)
+        self.states: list[PathState] = []
+
+    # -- helpers -------------------------------------------------------------------------------
+    def probes(self, u: np.ndarray) -> dict[str, float]:
+        return {n: float(c @ u) for n, c in self.c.items()}
+
+    def wnorm(self, du: np.ndarray, dlam: float) -> float:
+        return math.sqrt(float(du @ du) + (self.psi * dlam) ** 2)
+
+    def accept(self, u: np.ndarray, lam: float, its: int, neg: int | None, cuts: int) -> None:
+        state = PathState(len(self.states), u.copy(), float(lam), its, self.probes(u), neg, cuts)
+        self.states.append(state)
+        self.system.commit(state.u.copy(), state.load_factor)
+        if self.progress is not None:
+            self.progress(state)
+
+    def finish(self, reached: bool, message: str) -> PathResult:
+        return PathResult(self.states, reached, message, find_limit_points(self.states))
+
+    # -- the run -------------------------------------------------------------------------------
+    def run(self) -> PathResult:
+        opt = self.opt
+        u0 = np.zeros(self.system.size)
+        try:
+            fac = self.system.factorize(self.system.tangent(u0))
+            t = np.asarray(fac.solve(self.f_ref), dtype=float)
+        except RECOVERABLE_ERRORS as exc:
+            self.accept(u0, 0.0, 0, None, 0)
+            return self.finish(False, f"step 1: the initial tangent cannot be factorised ({exc})")
+        self.accept(u0, 0.0, 0, fac.negative_pivots, 0)
+        tn = float(np.linalg.norm(t))
+        if not math.isfinite(tn) or tn == 0.0:
+            return self.finish(False, "step 1: f_ref is zero or the linear solution is not finite")
+        self.psi = opt.arc_load_weight * tn
+        self.lam_est = self._target_load_estimate(t)
+        h = opt.initial_increment or self._auto_increment(t)
+        h_min = opt.min_increment if opt.min_increment is not None else 1e-4 * h
+        h_max = opt.max_increment if opt.max_increment is not None else 10.0 * h
+        if not (0.0 < h_min <= h <= h_max):
+            raise ValueError(f"need 0 < min_increment <= increment <= max_increment, got "
+                             f"{h_min}, {h}, {h_max}")
+        self.prev_step: tuple[np.ndarray, float] | None = None
+        self.sigma = 1.0 if self.lam_est >= 0 else -1.0
+        if opt.control == "displacement":  # move the probe the way the load would move it
+            ct = float(self.c[opt.driven_probe] @ t)
+            self.sigma = math.copysign(1.0, ct * self.lam_est) if ct != 0.0 else 1.0
+        self.newton = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations,
+                                     psi=self.psi)
+
+        while len(self.states) - 1 < opt.max_steps:
+            last = self.states[-1]
+            step = last.step + 1
+            if opt.control == "arc-length":
+                self.sigma = self._arc_direction(t, last)
+            cuts = 0
+            while True:
+                h_try, direct = self._clip_to_target(h, last)
+                trial, reason = self._attempt(h_try, last, t)
+                if trial is not None:
+                    break
+                h = 0.5 * h_try
+                cuts += 1
+                if h < h_min:
+                    hint = ""
+                    if opt.control == "load":
+                        hint = (" Under load control this usually means a load maximum (limit "
+                                "point) is near; use displacement or arc-length control.")
+                    elif opt.control == "displacement":
+                        hint = (" Under displacement control this usually means the driven "
+                                "probe has a turning point (snap-back) near; use arc-length "
+                                "control.")
+                    return self.finish(False, (
+                        f"step {step}: no convergence from λ = {last.load_factor:.6g} "
+                        f"({_fmt_probes(last.probes)}) with the {opt.control} increment cut "
+                        f"{cuts} times down to {h_try:.3g} (min_increment {h_min:.3g}); "
+                        f"last reason: {reason}.{hint}"))
+            crossed = ""
+            if not direct:
+                trial, h_try, crossed = self._hit_crossed_target(trial, h_try, last, t)
+            self.prev_step = (trial.u - last.u, trial.load_factor - last.load_factor)
+            fac = trial.factorization
+            self.accept(trial.u, trial.load_factor, trial.iterations, fac.negative_pivots, cuts)
+            try:
+                t = np.asarray(fac.solve(self.f_ref), dtype=float)
+            except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
+                return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
+            done = self._target_reached()
+            if done:
+                return self.finish(True, done)
+            if crossed:
+                s = self.states[-1]
+                return self.finish(False, (
+                    f"step {s.step}: the target on {crossed} was crossed but could not be hit "
+                    f"within target_tol = {opt.target_tol:g} (stopped at λ = "
+                    f"{s.load_factor:.6g}, {_fmt_probes(s.probes)})"))
+            factor = math.sqrt(opt.desired_iterations / max(trial.iterations, 1))
+            factor = min(max(factor, 0.5), 2.0)
+            if cuts:
+                factor = min(factor, 1.0)
+            h = min(max(h_try * factor, h_min), h_max)
+        s = self.states[-1]
+        return self.finish(False, (
+            f"max_steps = {opt.max_steps} reached at λ = {s.load_factor:.6g} "
+            f"({_fmt_probes(s.probes)}) before the target"))
+
+    # -- pieces ------------------------------------------------------------------------------
+    def _target_load_estimate(self, t: np.ndarray) -> float:
+        """Load factor of the target, estimated from the linear solution (1 if none)."""
+        ests = []
+        if self.opt.until_load_factor is not None:
+            ests.append(self.opt.until_load_factor)
+        if self.opt.until_probe is not None:
+            ct = float(self.c[self.opt.until_probe] @ t)
+            if ct != 0.0:
+                ests.append(self.opt.until_value / ct)
+        return min(ests, key=abs) if ests else 1.0
+
+    def _auto_increment(self, t: np.ndarray) -> float:
+        """1/20 of the (linearly estimated) distance to the target, in control units."""
+        lam = abs(self.lam_est)
+        if self.opt.control == "load":
+            return lam / 20.0
+        if self.opt.control == "displacement":
+            name = self.opt.driven_probe
+            if name == self.opt.until_probe:
+                return abs(self.opt.until_value) / 20.0
+            return abs(float(self.c[name] @ t)) * lam / 20.0 or lam / 20.0
+        return lam * math.sqrt(float(t @ t) + self.psi**2) / 20.0
+
+    def _clip_to_target(self, h: float, last: PathState) -> tuple[float, bool]:
+        """Shorten ``h`` so that a directly controlled target is hit exactly.
+
+        Returns the increment and whether the target of the control variable is hit by it.
+        """
+        opt = self.opt
+        if opt.control == "load" and opt.until_load_factor is not None:
+            rem = abs(opt.until_load_factor - last.load_factor)
+            self.sigma = math.copysign(1.0, opt.until_load_factor - last.load_factor)
+            if h >= rem:
+                return rem, True
+        if (opt.control == "displacement" and opt.until_probe is not None
+                and opt.driven_probe == opt.until_probe):
+            v = last.probes[opt.until_probe]
+            rem = abs(opt.until_value - v)
+            self.sigma = math.copysign(1.0, opt.until_value - v)
+            if h >= rem:
+                return rem, True
+        return h, False
+
+    def _arc_direction(self, t: np.ndarray, last: PathState) -> float:
+        """Sign of the arc-length predictor: forward along the path.
+
+        The predictor ``σ(t, 1)`` must make an acute angle with the previous step. When that angle
+        is within ~84° of a right angle (|cos| < 0.1) the test is unreliable and the sign of the
+        previous Δλ is flipped on each change of the negative-pivot count (det K changes sign).
+        """
+        if self.prev_step is None:
+            return self.sigma
+        du, dl = self.prev_step
+        dot = float(t @ du) + self.psi**2 * dl
+        denom = self.wnorm(t, 1.0) * self.wnorm(du, dl)
+        prev = self.states[-2] if len(self.states) >= 2 else None
+        if denom > 0.0 and abs(dot) >= 0.1 * denom:
+            return math.copysign(1.0, dot)
+        if prev is not None and None not in (prev.negative_pivots, last.negative_pivots):
+            flips = abs(last.negative_pivots - prev.negative_pivots) % 2
+            return math.copysign(1.0, dl) * (-1.0 if flips else 1.0)
+        return math.copysign(1.0, dot) if dot != 0.0 else self.sigma
+
+    def _attempt(self, h: float, last: PathState, t: np.ndarray) -> tuple[_Trial | None, str]:
+        """One predictor–corrector step of size ``h`` from ``last``."""
+        opt = self.opt
+        if opt.control == "load":
+            target = (opt.until_load_factor if opt.until_load_factor is not None
+                      and h == abs(opt.until_load_factor - last.load_factor)
+                      else last.load_factor + self.sigma * h)
+            dlam = target - last.load_factor
+            constraint = LoadConstraint(target)
+        elif opt.control == "displacement":
+            name = opt.driven_probe
+            c = self.c[name]
+            ct = float(c @ t)
+            v0 = last.probes[name]
+            target = (opt.until_value if name == opt.until_probe
+                      and h == abs(opt.until_value - v0) else v0 + self.sigma * h)
+            if ct == 0.0 or not math.isfinite(ct):
+                return None, f"probe {name} does not respond to the load"
+            dlam = (target - v0) / ct
+            constraint = ProbeConstraint(c, target)
+        else:
+            dlam = self.sigma * h / self.wnorm(t, 1.0)
+            constraint = ArcLengthConstraint(h, self.psi)
+        du_pred = dlam * t
+        pred_len = self.wnorm(du_pred, dlam)
+        if self.prev_step is not None:
+            prev_len = self.wnorm(*self.prev_step)
+            if pred_len > opt.max_predictor_growth * prev_len:
+                return None, (f"predictor {pred_len:.3g} longer than {opt.max_predictor_growth}"
+                              f" × the previous step {prev_len:.3g}")
+        floor = float(np.linalg.norm(self.f_ref)) * max(abs(s.load_factor) for s in self.states)
+        settings = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations, psi=self.psi,
+                                  force_floor=floor)
+        res = newton_correct(self.system, last.u + du_pred, last.load_factor + dlam, constraint,
+                             settings, last.u, last.load_factor)
+        if not res.converged or res.factorization is None:
+            return None, res.reason
+        dist = self.wnorm(res.u - last.u - du_pred, res.load_factor - last.load_factor - dlam)
+        if dist > opt.max_correction_ratio * pred_len:
+            return None, (f"corrector moved {dist:.3g} from a predictor of length {pred_len:.3g}"
+                          f" (jump to another branch?)")
+        return _Trial(res.u, res.load_factor, res.iterations, res.factorization), "converged"
+
+    def _crossings(self, last: PathState, trial: _Trial) -> list[tuple[float, str, float]]:
+        """Targets crossed between ``last`` and ``trial``: (linear fraction, name, target)."""
+        out = []
+        pairs = []
+        if self.opt.until_load_factor is not None:
+            pairs.append(("λ", self.opt.until_load_factor, last.load_factor, trial.load_factor))
+        if self.opt.until_probe is not None:
+            c = self.c[self.opt.until_probe]
+            pairs.append((self.opt.until_probe, self.opt.until_value,
+                          last.probes[self.opt.until_probe], float(c @ trial.u)))
+        for name, target, a, b in pairs:
+            if (a - target) * (b - target) <= 0.0 and a != b:
+                out.append(((target - a) / (b - a), name, target))
+        return sorted(out)
+
+    def _value(self, name: str, u: np.ndarray, lam: float) -> float:
+        return lam if name == "λ" else float(self.c[name] @ u)
+
+    def _hit_crossed_target(
+        self, trial: _Trial, h: float, last: PathState, t: np.ndarray
+    ) -> tuple[_Trial, float, str]:
+        """If ``trial`` overshoots a stopping target, shorten the step to hit it.
+
+        The step size ``x ∈ (0, h)`` is found by regula falsi with the Illinois modification on
+        ``g(x) = value(step of size x) − target``, each evaluation a full corrector run from
+        ``last``. Returns the step to accept, its size and the crossed target's name ("" if
+        none was crossed).
+        """
+        crossed = self._crossings(last, trial)
+        if not crossed:
+            return trial, h, ""
+        _, name, target = crossed[0]
+        scale = max(abs(target), *(abs(self._value(name, s.u, s.load_factor))
+                                   for s in self.states))
+        tol = self.opt.target_tol * scale
+        a, fa = 0.0, self._value(name, last.u, last.load_factor) - target
+        b, fb = h, self._value(name, trial.u, trial.load_factor) - target
+        best, best_h, best_g = trial, h, fb
+        side = 0
+        for _ in range(40):
+            if abs(best_g) <= tol or fa == fb:
+                break
+            x = (a * fb - b * fa) / (fb - fa)
+            if not (min(a, b) < x < max(a, b)):
+                x = 0.5 * (a + b)
+            cand, _ = self._attempt(x, last, t)
+            if cand is None:  # a shorter step should converge; give up on hitting if not
+                break
+            fx = self._value(name, cand.u, cand.load_factor) - target
+            if abs(fx) < abs(best_g):
+                best, best_h, best_g = cand, x, fx
+            if fx * fb > 0.0:
+                b, fb = x, fx
+                if side == -1:
+                    fa *= 0.5
+                side = -1
+            else:
+                a, fa = x, fx
+                if side == 1:
+                    fb *= 0.5
+                side = 1
+        return best, best_h, name
+
+    def _target_reached(self) -> str:
+        """Message if the last state satisfies a stopping target, else ``""``."""
+        s = self.states[-1]
+        opt = self.opt
+        if opt.until_load_factor is not None:
+            tol = opt.target_tol * abs(opt.until_load_factor)
+            if abs(s.load_factor - opt.until_load_factor) <= tol:
+                return (f"reached λ = {s.load_factor:.6g} (target {opt.until_load_factor:.6g}) "
+                        f"at step {s.step}")
+        if opt.until_probe is not None:
+            v = s.probes[opt.until_probe]
+            scale = max(abs(opt.until_value), *(abs(x.probes[opt.until_probe])
+                                                for x in self.states))
+            if abs(v - opt.until_value) <= opt.target_tol * scale:
+                return (f"reached {opt.until_probe} = {v:.6g} (target {opt.until_value:.6g}) "
+                        f"at step {s.step}, λ = {s.load_factor:.6g}")
+        return ""
+
+
+def follow_path(
+    system: DiscreteSystem,
+    options: PathOptions,
+    probe_names: Sequence[str],
+    progress: Callable[[PathState], None] | None = None,
+) -> PathResult:
+    """Follow the equilibrium path of ``system`` from the unloaded state.
+
+    Parameters
+    ----------
+    system
+        The model (see :class:`~sandwich.solver.system.DiscreteSystem`).
+    options
+        Control, stopping rules and tolerances.
+    probe_names
+        Probes recorded in every state (the until and driven probes are always added).
+    progress
+        Called with every converged state (state 0 included), after ``system.commit``.
+
+    Returns
+    -------
+    PathResult
+        All converged states (never NaN), whether a target was reached, a message saying where
+        and why the path stopped, and the limit points / bifurcations found along it.
+    """
+    return _Follower(system, options, probe_names, progress).run()
