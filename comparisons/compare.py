@@ -1,0 +1,189 @@
+"""``compare``: both models on one scene, written into one folder.
+
+Overlay figures (PNG + CSV each), deformed pictures and ``metrics.json``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from comparisons.deformed import draw_face_lines, render_snapshot
+from comparisons.metrics import Metrics, compute_metrics
+from comparisons.paths import LOAD, Curve, limit_loads, path_parameter, series
+from comparisons.plots import Panel, overlay
+from comparisons.profiles import ChosenProfile, choose_common
+from comparisons.runs import BEAM, MODELS, REFERENCE, ModelRun, Progress, Solver, obtain
+from comparisons.snapshots import face_lines, snapshot_of
+from sandwich.results import Solution, atomic_write_text
+from sandwich.scene import Scene, load_scene
+
+DEFAULT_RESULTS = Path("results")
+
+
+@dataclass
+class Comparison:
+    """The outcome of :func:`compare` on one scene."""
+
+    scene: Scene
+    out_dir: Path
+    runs: dict[str, ModelRun]
+    metrics: Metrics
+    figures: list[Path] = field(default_factory=list)
+    tables: list[Path] = field(default_factory=list)
+    chosen_profiles: dict[str, ChosenProfile] = field(default_factory=dict)
+
+    @property
+    def solutions(self) -> dict[str, Solution]:
+        """The solutions that exist, by model."""
+        return {m: r.solution for m, r in self.runs.items() if r.solution is not None}
+
+    @property
+    def missing(self) -> dict[str, str]:
+        """Models without a solution, with the reason."""
+        return {m: r.reason for m, r in self.runs.items() if r.solution is None}
+
+
+def total_force(scene: Scene) -> float:
+    """Σ|force| of the scene's loads (N): the load is P = λ · Σ|F|."""
+    return float(sum(abs(ld.force) for ld in scene.loads)) or 1.0
+
+
+def _debond_spans(scene: Scene, interface: str | None = None) -> list[tuple[float, float]]:
+    return [(d.start, d.end) for d in scene.debonds
+            if (interface is None or d.interface == interface) and d.length > 0]
+
+
+def _path_figures(cmp: Comparison) -> None:
+    scale = total_force(cmp.scene)
+    sols = cmp.solutions
+    for probe in cmp.scene.probes:
+        curves, markers = [], []
+        for model in (REFERENCE, BEAM):
+            s = sols.get(model)
+            if s is None or not s.history or probe.name not in s.history[0].probes:
+                continue
+            load = series(s, LOAD) * scale
+            w = series(s, probe.name)
+            curves.append(Curve(f"{model}", w, load))
+            markers += [(f"{model} max", float(w[i]), float(load[i])) for i in limit_loads(load)]
+        until = " (path parameter)" if probe.name == cmp.scene.analysis.until_probe else ""
+        panel = Panel("load P (N)", curves, markers=markers)
+        png, csv_ = overlay(cmp.out_dir / f"load_{probe.name}.png", [panel],
+                            f"{probe.name} (mm)", f"{cmp.scene.name}: load vs {probe.name}{until}")
+        cmp.figures.append(png)
+        cmp.tables.append(csv_)
+
+
+def _profile_curves(chosen: Mapping[str, ChosenProfile], column: str, suffix: str = ""
+                    ) -> list[Curve]:
+    out = []
+    for model in (REFERENCE, BEAM):
+        c = chosen.get(model)
+        if c is None or column not in c.profile.columns:
+            continue
+        x = np.asarray(c.profile.columns["x"], dtype=float)
+        order = np.argsort(x, kind="stable")
+        out.append(Curve(f"{model}{suffix}", x[order],
+                         np.asarray(c.profile.columns[column], dtype=float)[order]))
+    return out
+
+
+def _level_text(chosen: Mapping[str, ChosenProfile], abscissa: str) -> str:
+    return "; ".join(f"{m}: step {c.profile.step}, |{abscissa}|={c.level:.4g}, "
+                     f"λ={c.load_factor:.4g}" for m, c in chosen.items())
+
+
+def _profile_figures(cmp: Comparison, abscissa: str) -> None:
+    chosen = cmp.chosen_profiles
+    if not chosen:
+        return
+    sub = _level_text(chosen, abscissa)
+    all_spans = _debond_spans(cmp.scene)
+    figures = {
+        "face_deflections": [
+            Panel("w (mm)", _profile_curves(chosen, "w_top", " w_top")
+                  + _profile_curves(chosen, "w_bottom", " w_bottom"), spans=all_spans)],
+        "interface_stress": [
+            Panel("σzz top (MPa)", _profile_curves(chosen, "sigma_zz_top"),
+                  title="top face/core interface", spans=_debond_spans(cmp.scene, "top")),
+            Panel("σzz bottom (MPa)", _profile_curves(chosen, "sigma_zz_bottom"),
+                  title="bottom face/core interface", spans=_debond_spans(cmp.scene, "bottom"))],
+        "core_shear": [Panel("τ core (MPa)", _profile_curves(chosen, "tau_core"),
+                             spans=all_spans)],
+    }
+    for stem, panels in figures.items():
+        png, csv_ = overlay(cmp.out_dir / f"{stem}.png", panels, "x (mm)",
+                            f"{cmp.scene.name}: {stem.replace('_', ' ')}\n{sub}")
+        cmp.figures.append(png)
+        cmp.tables.append(csv_)
+
+
+def _deformed_figures(cmp: Comparison) -> None:
+    lines, titles = [], []
+    for model in (REFERENCE, BEAM):
+        run = cmp.runs.get(model)
+        if run is None or run.solution is None:
+            continue
+        snap = snapshot_of(run.solution, run.folder)
+        if snap is not None:
+            cmp.figures.append(render_snapshot(snap, cmp.out_dir / f"deformed_{model}.png"))
+        elif model in cmp.chosen_profiles:
+            c = cmp.chosen_profiles[model]
+            lines.append(face_lines(cmp.scene, c.profile, model))
+            titles.append(f"{model} (faces from profiles): step {c.profile.step}, "
+                          f"λ = {c.load_factor:.4g}")
+    if lines:
+        cmp.figures.append(draw_face_lines(lines, titles, cmp.out_dir / "deformed_faces.png"))
+
+
+def compare(scene: Scene | str | Path, out_dir: str | Path, *, reuse: bool = True,
+            progress: Progress | None = None, results_root: str | Path = DEFAULT_RESULTS,
+            solvers: Mapping[str, Solver] | None = None) -> Comparison:
+    """Run (or reuse) both models on ``scene`` and write the comparison into ``out_dir``.
+
+    Parameters
+    ----------
+    scene
+        A :class:`~sandwich.scene.Scene` or the path of a scene file.
+    out_dir
+        Folder for figures (PNG + CSV each), deformed pictures and ``metrics.json``.
+    reuse
+        Reuse a model's result folder when it is fresh (newer than scene and sources).
+    progress
+        Receives a :class:`~comparisons.runs.ProgressEvent` per phase and converged step.
+    results_root
+        Root of the models' result folders (``<root>/<scene>/<model>/``).
+    solvers
+        Replacement ``solve`` callables by model name (tests, benchmarks).
+
+    Returns
+    -------
+    Comparison
+        The runs, metrics and files written. A model that is missing or failed is listed in
+        :attr:`Comparison.missing` and in ``metrics.json``; figures show what exists.
+    """
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    solvers = dict(solvers or {})
+    runs = {m: obtain(scene, m, results_root=Path(results_root), reuse=reuse, progress=progress,
+                      solver=solvers.get(m)) for m in MODELS}
+    present = [r.solution for r in runs.values() if r.solution is not None and r.solution.history]
+    abscissa = path_parameter(scene.analysis.until_probe, present)
+    metrics = compute_metrics(scene.name, runs, abscissa)
+    cmp = Comparison(scene, out_dir, runs, metrics)
+    if present:
+        chosen = choose_common(present, abscissa)
+        cmp.chosen_profiles = {c.model: c for c in chosen or []}
+    _path_figures(cmp)
+    _profile_figures(cmp, abscissa)
+    _deformed_figures(cmp)
+    atomic_write_text(out_dir / "metrics.json",
+                      json.dumps(metrics.to_dict(), indent=2, allow_nan=False) + "\n")
+    return cmp
