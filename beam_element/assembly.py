@@ -1,0 +1,65 @@
+"""Sparse assembly straight into the eliminated (free) DOFs, on a precomputed pattern.
+
+Each local contribution (element layer or contact pair) is a dense block on a list of full DOFs.
+With u_full = T u_free and T holding at most one ±1 per row (:mod:`beam_element.constraints`),
+the reduced tangent Tᵀ K T is a signed scatter of the local entries. The scatter map — which CSR
+slot each local entry lands in and with which sign — is computed once; assembling is then one
+``np.bincount``. Node-wise numbering keeps the reduced matrix banded.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from beam_element.constraints import DofMap
+
+
+@dataclass(frozen=True)
+class ReducedPattern:
+    """Where the entries of a list of dense local blocks go in the reduced CSR matrix."""
+
+    block_dofs: tuple[np.ndarray, ...]  # per block family: (B, n) full DOF indices
+    slot: np.ndarray  # CSR slot of each kept local entry
+    keep: np.ndarray  # bool over all local entries (families concatenated, row-major)
+    weight: np.ndarray  # sign product of each kept entry
+    indices: np.ndarray
+    indptr: np.ndarray
+    n: int
+
+    def assemble(self, blocks: list[np.ndarray]) -> sp.csr_matrix:
+        """Reduced matrix Tᵀ K T from local blocks, one array (B, n, n) per family."""
+        values = np.concatenate([b.reshape(-1) for b in blocks])[self.keep]
+        data = np.bincount(self.slot, weights=self.weight * values, minlength=self.indices.size)
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+
+
+def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPattern:
+    """Precompute the scatter of local blocks (full DOF index arrays ``(B, n)``) into Tᵀ K T."""
+    rows = np.concatenate([np.repeat(d[:, :, None], d.shape[1], axis=2).reshape(-1)
+                           for d in block_dofs])
+    cols = np.concatenate([np.repeat(d[:, None, :], d.shape[1], axis=1).reshape(-1)
+                           for d in block_dofs])
+    r, c = dof_map.free[rows], dof_map.free[cols]
+    keep = (r >= 0) & (c >= 0)
+    n = dof_map.n_free
+    keys = r[keep].astype(np.int64) * n + c[keep]
+    unique, slot = np.unique(keys, return_inverse=True)
+    row_of = unique // n
+    indptr = np.searchsorted(row_of, np.arange(n + 1))
+    return ReducedPattern(
+        block_dofs=tuple(block_dofs), slot=slot, keep=keep,
+        weight=dof_map.sign[rows[keep]] * dof_map.sign[cols[keep]],
+        indices=(unique % n).astype(np.int32), indptr=indptr.astype(np.int32), n=n,
+    )
+
+
+def scatter_vector(
+    n_full: int, block_dofs: list[np.ndarray], blocks: list[np.ndarray]
+) -> np.ndarray:
+    """Full vector Σ of local vectors, one (B, n) array per family."""
+    idx = np.concatenate([d.reshape(-1) for d in block_dofs])
+    val = np.concatenate([b.reshape(-1) for b in blocks])
+    return np.bincount(idx, weights=val, minlength=n_full)

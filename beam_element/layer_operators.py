@@ -1,0 +1,139 @@
+"""Shape-function matrices N, M of each layer and their reference derivatives (eqs. 10-14).
+
+For one layer, at a set of points (η, ξ) of the reference element, this builds the rows of
+
+    u_j = N_j u_e,  w_j = M_j u_e          (eq. 10, 13)
+
+restricted to the element DOFs the layer depends on, together with ∂/∂η and ∂/∂ξ of them. The
+rows are built from the DOF table (:mod:`beam_element.dofs`): each DOF contributes
+X_kind(η) · Z_kind(ξ) to the row of its field.
+
+Convention: x-slope DOFs enter through the reference slope function (length 2), so an element's
+DOF vector must be scaled by l/2 on x-slopes before use (:func:`x_slope_scale`). The thickness is
+the same for every element, so the h/2 of z-slope DOFs is folded into the rows here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from beam_element.dofs import DOF_TABLE, NODE_DOFS, NODES_PER_ELEMENT, layer_element_dofs
+from beam_element.quadrature import tensor_rule
+from beam_element.shape_functions import slope_scale_x, slope_scale_z, x_shape, z_shape
+
+
+@dataclass(frozen=True)
+class LayerOperators:
+    """Shape-function rows of one layer at points (η, ξ), on the layer's element DOFs.
+
+    Attributes
+    ----------
+    name
+        ``"top"``, ``"core"`` or ``"bottom"``.
+    dofs
+        Element-local indices (0..39) of the layer's DOFs, shape ``(n,)``.
+    thickness
+        Layer thickness h (mm).
+    z_bottom
+        z of the layer's bottom surface (mm), z = 0 at the core mid-plane.
+    stiffness
+        Voigt stiffness (MPa) in the order (ε_x, ε_z, γ).
+    eta, xi, weight
+        Points and weights, shape ``(G,)``.
+    N, M
+        Rows of u and w (eq. 13), shape ``(G, n)``.
+    N_eta, N_xi, M_eta, M_xi
+        Their derivatives with respect to η and ξ, shape ``(G, n)``.
+    x_slope
+        Boolean mask of x-slope DOFs, shape ``(n,)``.
+    """
+
+    name: str
+    dofs: np.ndarray
+    thickness: float
+    z_bottom: float
+    stiffness: np.ndarray
+    eta: np.ndarray
+    xi: np.ndarray
+    weight: np.ndarray
+    N: np.ndarray
+    M: np.ndarray
+    N_eta: np.ndarray
+    N_xi: np.ndarray
+    M_eta: np.ndarray
+    M_xi: np.ndarray
+    x_slope: np.ndarray
+
+    def at(self, eta: np.ndarray, xi: np.ndarray) -> LayerOperators:
+        """The same layer's rows at other points (weights set to zero)."""
+        return build_layer_operators(
+            self.name, self.thickness, self.z_bottom, self.stiffness, eta=eta, xi=xi
+        )
+
+    def x_slope_scale(self, lengths: np.ndarray) -> np.ndarray:
+        """Per-element DOF scale, shape ``(E, n)``: l/2 on x-slope DOFs, 1 elsewhere."""
+        return np.where(self.x_slope[None, :], 0.5 * np.asarray(lengths)[:, None], 1.0)
+
+
+def build_layer_operators(
+    name: str,
+    thickness: float,
+    z_bottom: float,
+    stiffness: np.ndarray,
+    *,
+    gauss: tuple[int, int] | None = None,
+    eta: np.ndarray | None = None,
+    xi: np.ndarray | None = None,
+) -> LayerOperators:
+    """Build the rows of eq. (13) for one layer, at a Gauss rule or at given points.
+
+    Parameters
+    ----------
+    name
+        Layer name.
+    thickness, z_bottom
+        Thickness h (mm) and z of its bottom surface (mm).
+    stiffness
+        Voigt stiffness (MPa), see :mod:`beam_element.constitutive`.
+    gauss
+        Orders (n_η, n_ξ) of a tensor Gauss rule; or give ``eta`` and ``xi`` instead.
+    eta, xi
+        Explicit points (same shape); their weights are zero.
+    """
+    if not (np.isfinite(thickness) and thickness > 0):
+        raise ValueError(f"{name} layer thickness must be positive, got {thickness!r}")
+    if gauss is not None:
+        eta, xi, weight = tensor_rule(*gauss)
+    elif eta is not None and xi is not None:
+        eta = np.atleast_1d(np.asarray(eta, dtype=float))
+        xi = np.atleast_1d(np.asarray(xi, dtype=float))
+        if eta.shape != xi.shape:
+            raise ValueError("eta and xi must have the same shape")
+        weight = np.zeros_like(eta)
+    else:
+        raise ValueError("give either gauss orders or both eta and xi")
+
+    dofs = np.array(layer_element_dofs(name))
+    G, n = eta.size, dofs.size
+    rows = {key: np.zeros((G, n)) for key in ("N", "M", "N_eta", "N_xi", "M_eta", "M_xi")}
+    x_slope = np.zeros(n, dtype=bool)
+    for a, element_dof in enumerate(dofs):
+        node, i = divmod(int(element_dof), NODE_DOFS)
+        assert node < NODES_PER_ELEMENT
+        d = DOF_TABLE[i]
+        X, X_eta = x_shape(d.x_kind, node, eta)
+        Z, Z_xi = z_shape(d.z_kind, xi)
+        z_scale = 0.5 * thickness if slope_scale_z(d.z_kind) else 1.0  # Hbar(ξ; h) = h/2 Hbar_ref
+        x_slope[a] = slope_scale_x(d.x_kind)
+        value, d_eta, d_xi = (z_scale * X * Z, z_scale * X_eta * Z, z_scale * X * Z_xi)
+        if d.field == "u":
+            rows["N"][:, a], rows["N_eta"][:, a], rows["N_xi"][:, a] = value, d_eta, d_xi
+        else:
+            rows["M"][:, a], rows["M_eta"][:, a], rows["M_xi"][:, a] = value, d_eta, d_xi
+    return LayerOperators(
+        name=name, dofs=dofs, thickness=float(thickness), z_bottom=float(z_bottom),
+        stiffness=np.asarray(stiffness, dtype=float), eta=eta, xi=xi, weight=weight,
+        x_slope=x_slope, **rows,
+    )

@@ -1,0 +1,271 @@
+"""The discretised sandwich beam, the ``DiscreteSystem`` (``sandwich.solver.system``) to solve.
+
+:func:`build_model` turns a scene into nodes (:mod:`~beam_element.mesh`), layer rules
+(:mod:`~beam_element.layer_operators`), the elimination of ties and supports
+(:mod:`~beam_element.constraints`), loads and probes (:mod:`~beam_element.loads`) and contact pairs
+on debonded stretches (:mod:`~beam_element.contact`). :class:`BeamModel` evaluates the internal
+force and tangent on the free DOFs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from beam_element.assembly import ReducedPattern, reduced_pattern, scatter_vector
+from beam_element.constitutive import core_stiffness, face_stiffness
+from beam_element.constraints import DofMap, NodeSupport, build_dof_map
+from beam_element.contact import ContactPairs, contact_pairs, penalty_response
+from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
+from beam_element.element import GeometricProducts, geometric_products, layer_response
+from beam_element.layer_operators import LayerOperators, build_layer_operators
+from beam_element.loads import patch_load, point_load, probe_row
+from beam_element.mesh import BeamMesh, build_mesh
+from beam_element.quadrature import EXACT_ORDER
+
+CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
+PENALTY_FACTOR = 1e4  # default contact penalty ε = PENALTY_FACTOR · Q_z / h_c  (N/mm³)
+PENETRATION_BOUND = 1e-3  # allowed penetration / face thickness
+
+
+@dataclass
+class ContactSummary:
+    """Contact state of a converged step, per interface, over all pairs."""
+
+    max_penetration: float = 0.0  # mm
+    max_pressure: float = 0.0  # MPa
+    max_sliding: float = 0.0  # mm, |t·Δ| of pairs in contact
+    active: int = 0  # pairs in contact
+
+
+@dataclass
+class BeamModel:
+    """Equilibrium R(u, λ) = f_int(u) − λ f_ref on the free DOFs of the beam model."""
+
+    name: str
+    mesh: BeamMesh
+    width: float
+    layers: dict[str, LayerOperators]
+    products: dict[str, GeometricProducts]
+    dof_map: DofMap
+    pairs: list[ContactPairs]
+    penalty: float
+    f_ref_full: np.ndarray
+    probe_rows: dict[str, np.ndarray]
+    face_thickness: dict[str, float]
+    pattern: ReducedPattern = field(init=False)
+    committed: dict[str, ContactSummary] = field(default_factory=dict)
+    max_penetration_seen: float = 0.0
+    max_sliding_seen: float = 0.0
+    _cache: tuple[np.ndarray, np.ndarray, sp.csr_matrix | None] | None = None
+
+    def __post_init__(self) -> None:
+        e = np.arange(self.mesh.n_elements)[:, None]
+        self.element_dofs = NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :]
+        self.block_dofs = [self.element_dofs[:, self.layers[n].dofs] for n in LAYERS]
+        self.block_dofs += [p.dofs for p in self.pairs]
+        self.pattern = reduced_pattern(self.block_dofs, self.dof_map)
+        self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
+
+    # --- DiscreteSystem -------------------------------------------------------------------
+    @property
+    def size(self) -> int:
+        """Number of free unknowns."""
+        return self.dof_map.n_free
+
+    @property
+    def f_ref(self) -> np.ndarray:
+        """Reference load on the free DOFs (N, N·mm)."""
+        return self.f_ref_free
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        """f_int(u) on the free DOFs, contact included (eq. 19 assembled, Tᵀ f)."""
+        return self._evaluate(u, tangent=False)[0]
+
+    def tangent(self, u: np.ndarray) -> sp.csr_matrix:
+        """Consistent tangent Tᵀ K T at ``u`` (eqs. 24-25 plus contact)."""
+        K = self._evaluate(u, tangent=True)[1]
+        assert K is not None
+        return K
+
+    def factorize(self, K: sp.spmatrix) -> object:
+        """Sparse LU of the tangent (with inertia when the shared backend provides it)."""
+        try:
+            from sandwich.solver.sparse import SparseFactorization
+        except ImportError:  # the shared backend is not there yet
+            return _SpluFactorization(K)
+        return SparseFactorization(K)
+
+    def probe_vector(self, name: str) -> np.ndarray:
+        """C on the free DOFs with probe value c · u (mm)."""
+        if name not in self.probe_rows:
+            raise ValueError(f"unknown probe {name!r}; known: {sorted(self.probe_rows)}")
+        return self.dof_map.reduce(self.probe_rows[name])
+
+    def commit(self, u: np.ndarray, load_factor: float) -> None:
+        """Record the contact state of a converged step."""
+        self.committed = self.contact_summary(u)
+        for s in self.committed.values():
+            self.max_penetration_seen = max(self.max_penetration_seen, s.max_penetration)
+            self.max_sliding_seen = max(self.max_sliding_seen, s.max_sliding)
+
+    # --- evaluation -----------------------------------------------------------------------
+    def expand(self, u: np.ndarray) -> np.ndarray:
+        """Full DOF vector (20 per node) of free DOFs ``u``."""
+        u = np.asarray(u, dtype=float)
+        if u.shape != (self.size,):
+            raise ValueError(f"expected a vector of {self.size} free DOFs, got shape {u.shape}")
+        return self.dof_map.expand(u)
+
+    def _evaluate(self, u: np.ndarray, tangent: bool) -> tuple[np.ndarray, sp.csr_matrix | None]:
+        if self._cache is not None and np.array_equal(self._cache[0], u):
+            if not tangent or self._cache[2] is not None:
+                return self._cache[1], self._cache[2]
+        f_full, blocks = self.full_response(self.expand(u), tangent)
+        f = self.dof_map.reduce(f_full)
+        K = self.pattern.assemble(blocks) if tangent else None
+        self._cache = (np.array(u, dtype=float, copy=True), f, K)
+        return f, K
+
+    def full_response(
+        self, u_full: np.ndarray, tangent: bool = True
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """Internal force on the full DOFs and the local tangent blocks (layers, then contact)."""
+        forces, blocks = [], []
+        lengths = self.mesh.lengths
+        u_e = u_full[self.element_dofs]
+        for name in LAYERS:
+            op, n = self.layers[name], self.layers[name].dofs.size
+            f = np.empty((self.mesh.n_elements, n))
+            K = np.empty((self.mesh.n_elements, n, n)) if tangent else None
+            for s in range(0, self.mesh.n_elements, CHUNK):
+                block = slice(s, s + CHUNK)
+                f[block], Kb = layer_response(op, u_e[block], lengths[block], self.width,
+                                              self.products[name], tangent)
+                if K is not None:
+                    K[block] = Kb
+            forces.append(f)
+            blocks.append(K)
+        for pairs in self.pairs:
+            fc, Kc, _, _ = penalty_response(pairs, u_full, self.penalty)
+            forces.append(fc)
+            blocks.append(Kc)
+        f_full = scatter_vector(u_full.size, self.block_dofs, forces)
+        return f_full, (blocks if tangent else [])
+
+    def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
+        """Penetration, pressure and sliding per interface at free DOFs ``u``."""
+        u_full = self.expand(u)
+        out = {}
+        for pairs in self.pairs:
+            _, _, p, k = penalty_response(pairs, u_full, self.penalty)
+            active = p > 0
+            out[pairs.interface] = ContactSummary(
+                max_penetration=float(np.max(-k.gap, initial=0.0)),
+                max_pressure=float(np.max(p, initial=0.0)),
+                max_sliding=float(np.max(np.abs(k.sliding[active]), initial=0.0)),
+                active=int(active.sum()),
+            )
+        return out
+
+    def penetration_bound(self) -> float:
+        """Allowed penetration (mm): PENETRATION_BOUND × the thinner face."""
+        return PENETRATION_BOUND * min(self.face_thickness.values())
+
+
+class _SpluFactorization:
+    """Fallback factorisation (SuperLU) used until ``sandwich.solver.sparse`` exists."""
+
+    def __init__(self, K: sp.spmatrix):
+        import scipy.sparse.linalg as spla
+
+        self._lu = spla.splu(sp.csc_matrix(K))
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self._lu.solve(np.asarray(b, dtype=float))
+
+    @property
+    def negative_pivots(self) -> int | None:
+        return None
+
+
+def mesh_stations(scene: object) -> list[float]:
+    """X positions that must be nodes: debond ends, supports, loads (patch edges), probes."""
+    pts: list[float] = []
+    for d in scene.debonds:
+        pts += [d.start, d.end]
+    pts += [s.x for s in scene.supports]
+    for load in scene.loads:
+        pts += [load.x] if load.width == 0 else [*load.span, load.x]
+    pts += [p.x for p in scene.probes]
+    return pts
+
+
+def build_model(
+    scene: object,
+    *,
+    elements: int | None = None,
+    gauss: dict[str, tuple[int, int]] | None = None,
+    contact_penalty: float | None = None,
+) -> BeamModel:
+    """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
+
+    Parameters
+    ----------
+    scene
+        The problem.
+    elements
+        Target element count over the length (default ``scene.beam_model.elements``).
+    gauss
+        Gauss orders (n_η, n_ξ) per layer name; default :data:`~beam_element.quadrature.EXACT_ORDER`
+        (exact for the polynomial strain energy).
+    contact_penalty
+        Contact penalty ε (N/mm³); default ``scene.beam_model.contact_penalty`` or
+        ``PENALTY_FACTOR · Q_z / h_c``.
+    """
+    options = getattr(scene, "beam_model", None)
+    if elements is None:
+        elements = getattr(options, "elements", 120)
+    mesh = build_mesh(scene.length, elements, mesh_stations(scene))
+    if not (np.isfinite(scene.width) and scene.width > 0):
+        raise ValueError(f"beam width must be positive, got {scene.width!r}")
+    orders = dict(EXACT_ORDER)
+    orders.update(gauss or {})
+    hc, ht, hb = scene.core.thickness, scene.top.thickness, scene.bottom.thickness
+    z_bottom = {"top": hc / 2, "core": -hc / 2, "bottom": -hc / 2 - hb}
+    stiffness = {"top": face_stiffness(scene.top.material),
+                 "core": core_stiffness(scene.core.material),
+                 "bottom": face_stiffness(scene.bottom.material)}
+    thickness = {"top": ht, "core": hc, "bottom": hb}
+    layers = {n: build_layer_operators(n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n])
+              for n in LAYERS}
+    products = {n: geometric_products(op) for n, op in layers.items()}
+
+    tol = 1e-9 * scene.length
+    bonded = {i: np.array([scene.is_bonded(i, float(x), tol) for x in mesh.x])
+              for i in ("top", "bottom")}
+    supports = [NodeSupport(mesh.node_at(s.x, 1e-6 * scene.length), face, s.type)
+                for s in scene.supports for face in s.faces]
+    dof_map = build_dof_map(mesh.n_nodes, bonded, supports)
+
+    f_ref = np.zeros(NODE_DOFS * mesh.n_nodes)
+    for load in scene.loads:
+        if load.width == 0:
+            f_ref += point_load(mesh, load.on, load.x, load.force)
+        else:
+            f_ref += patch_load(mesh, load.on, *load.span, load.force)
+    probes = {p.name: probe_row(mesh, p.on, p.x) for p in scene.probes}
+
+    pairs = [contact_pairs(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width)
+             for i in ("top", "bottom") if np.any(~bonded[i])]
+    if contact_penalty is None:
+        contact_penalty = getattr(options, "contact_penalty", None)
+    if contact_penalty is None:
+        contact_penalty = PENALTY_FACTOR * stiffness["core"][1, 1] / hc
+    return BeamModel(
+        name=scene.name, mesh=mesh, width=float(scene.width), layers=layers, products=products,
+        dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,
+        probe_rows=probes, face_thickness={"top": ht, "bottom": hb},
+    )

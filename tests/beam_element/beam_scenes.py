@@ -1,0 +1,60 @@
+"""Small scenes built in code for the beam-element tests (N, mm, MPa)."""
+
+from sandwich.scene import (
+    Analysis,
+    BeamModelOptions,
+    Debond,
+    Layer,
+    Load,
+    Material,
+    Probe,
+    Scene,
+    Support,
+)
+
+
+def isotropic(name, E, nu):
+    return Material(name, "isotropic", E, E, E / (2 * (1 + nu)), nu)
+
+
+KEVLAR = isotropic("kevlar", 27420.0, 0.3)
+ROHACELL = Material("rohacell", "orthotropic", 52.5, 52.5, 21.0, 0.25)
+
+
+def sandwich_scene(
+    *,
+    length=300.0,
+    width=60.0,
+    face=0.5,
+    core=25.0,
+    face_material=KEVLAR,
+    core_material=ROHACELL,
+    debonds=(),
+    supports=None,
+    loads=None,
+    probes=None,
+    elements=60,
+    analysis=None,
+    name="test",
+):
+    """Simply supported (bottom face, pin + roller) three-point bend unless told otherwise."""
+    if supports is None:
+        supports = (Support(0.0, "bottom", "pin"), Support(length, "bottom", "roller"))
+    if loads is None:
+        loads = (Load("top", length / 2, 10.0, -1.0),)
+    if probes is None:
+        probes = (Probe("w_top_mid", "top", length / 2),
+                  Probe("w_bottom_mid", "bottom", length / 2))
+    return Scene(
+        name=name, description="", length=length, width=width,
+        top=Layer(face, face_material), core=Layer(core, core_material),
+        bottom=Layer(face, face_material),
+        debonds=tuple(debonds), supports=tuple(supports), loads=tuple(loads),
+        probes=tuple(probes),
+        analysis=analysis or Analysis(kind="linear", until_load_factor=1.0),
+        beam_model=BeamModelOptions(elements=elements),
+    )
+
+
+__all__ = ["Debond", "Load", "Probe", "Support", "sandwich_scene", "KEVLAR", "ROHACELL",
+           "isotropic"]
