@@ -1,16 +1,22 @@
-"""Frictionless unilateral contact between the lips of a debond: node-to-segment penalty.
+"""Frictionless unilateral contact between the lips of a debond: small-sliding node-to-surface.
 
-Slave nodes are the face-lip nodes; the master curve is the core lip, the polyline through the
-crack-tip node, the core-lip nodes and the other tip node (a quadratic facet counts as two straight
-segments). Each slave node s sees the segment x1 → x2 it projects onto; the gap is the signed
-distance along the segment's deformed normal n = J (x2 − x1)/|x2 − x1|, J a +90° rotation, with the
-polyline ordered so that n points out of the core:
+Slave nodes are the face-lip nodes; each is paired with the coincident core-lip node (its anchor,
+x_0). The master surface near the anchor is the tangent line of the deformed core lip there, with
+its direction taken from the chord of the anchor's two neighbours on the core lip, x_1 → x_2
+(the crack-tip nodes close the chain at both ends). The gap is the signed distance of the slave
+from that line along its normal n = J (x_2 − x_1)/|x_2 − x_1|, J a +90° rotation, the chain being
+ordered so that n points out of the core:
 
-    g = (x2 − x1) × (x_s − x1) / |x2 − x1|.
+    g = n · (x_s − x_0) = (x_2 − x_1) × (x_s − x_0) / |x_2 − x_1|.
+
+This is the "small-sliding" node-to-surface formulation (the slave stays near its anchor; the
+tangential slip (x_s − x_0) · t is reported so that this can be checked). Unlike node-to-segment
+with a polyline, g is a smooth function of the nodal positions: at the start every slave sits
+exactly on a master node, where the normal of a polyline jumps and Newton cycles.
 
 The contact energy of a node is Π = ½ k b w_s ⟨−g⟩² (k penalty in N/mm³, b the width, w_s the
-slave node's tributary length), so its force ∂Π/∂X and tangent ∂²Π/∂X² are exact derivatives of
-one scalar: the tangent is consistent and symmetric. Pressure p = k ⟨−g⟩ (MPa).
+slave's tributary length), so its force ∂Π/∂X and tangent ∂²Π/∂X² are exact derivatives of one
+scalar: the tangent is consistent and symmetric. Pressure p = k ⟨−g⟩ (MPa).
 """
 
 from __future__ import annotations
@@ -20,21 +26,23 @@ from dataclasses import dataclass
 import numpy as np
 
 J = np.array([[0.0, -1.0], [1.0, 0.0]])  # rotation by +90°
-# X = (x_s, x_1, x_2) stacked (6,); d = x_s − x_1 and a = x_2 − x_1 as linear maps of X
-_D = np.hstack([np.eye(2), -np.eye(2), np.zeros((2, 2))])
-_A = np.hstack([np.zeros((2, 2)), -np.eye(2), np.eye(2)])
+# X = (x_s, x_0, x_1, x_2) stacked (8,); d = x_s − x_0 and a = x_2 − x_1 as linear maps of X
+_Z = np.zeros((2, 2))
+_I = np.eye(2)
+_D = np.hstack([_I, -_I, _Z, _Z])
+_A = np.hstack([_Z, _Z, -_I, _I])
 
 
-def gap_with_derivatives(xs, x1, x2):
-    """Signed gap g of x_s from the line x1 → x2, its gradient (6,) and Hessian (6, 6) in X."""
-    d = xs - x1
+def gap_with_derivatives(xs, x0, x1, x2):
+    """Signed gap g of x_s from the line through x0 along x1 → x2; gradient (8,), Hessian (8, 8)."""
+    d = xs - x0
     a = x2 - x1
     L2 = a @ a
     L = np.sqrt(L2)
     n = J @ a / L
     g = n @ d
     g_d = n  # ∂g/∂d
-    g_a = -J @ d / L - g * a / L2  # ∂g/∂a: ∂(a×d)/∂a = (d_z, −d_x) = −J d
+    g_a = -J @ d / L - g * a / L2  # ∂g/∂a, using ∂(a × d)/∂a = (d_z, −d_x) = −J d
     H_da = J / L - np.outer(n, a) / L2  # ∂n/∂a = ∂²g/∂d∂a
     H_aa = (np.outer(J @ d, a) / (L2 * L) - np.outer(a, g_a) / L2 - g * np.eye(2) / L2
             + 2.0 * g * np.outer(a, a) / (L2 * L2))
@@ -45,15 +53,19 @@ def gap_with_derivatives(xs, x1, x2):
 
 @dataclass
 class ContactPair:
-    """One debond's lips as node indices (local DOF blocks) plus reference data."""
+    """One debond's lips as local DOF blocks plus reference data."""
 
-    slave: np.ndarray  # (ns,) blocks of face-lip nodes
-    master: np.ndarray  # (nm,) blocks of the core-lip polyline, tip to tip, normal out of core
+    slave: np.ndarray  # (ns,) face-lip nodes
+    anchor: np.ndarray  # (ns,) the coincident core-lip node of each slave
+    chord: np.ndarray  # (ns, 2) core-lip neighbours (x_1, x_2) of each anchor, n out of the core
     weight: np.ndarray  # (ns,) tributary length of each slave node (mm)
-    window: np.ndarray  # (ns, 2) first and last master *segment* a slave may use
     penalty: float  # k (N/mm³)
     width: float  # b (mm)
     x_ref: np.ndarray  # (ns,) reference x of the slave nodes (for profiles)
+
+    def blocks(self, i: int) -> np.ndarray:
+        """The four DOF blocks (s, 0, 1, 2) slave i's gap depends on."""
+        return np.array([self.slave[i], self.anchor[i], self.chord[i, 0], self.chord[i, 1]])
 
 
 @dataclass
@@ -61,47 +73,34 @@ class ContactState:
     """Result of one contact evaluation."""
 
     gap: np.ndarray  # (ns,) signed gaps (mm), negative = penetration
+    slip: np.ndarray  # (ns,) tangential offset of the slave from its anchor (mm)
     pressure: np.ndarray  # (ns,) p = k ⟨−g⟩ (MPa)
-    rows: list[np.ndarray]  # per active slave: the 3 DOF blocks (s, m1, m2)
-    forces: list[np.ndarray]  # per active slave: (6,) ∂Π/∂X
-    tangents: list[np.ndarray]  # per active slave: (6, 6) ∂²Π/∂X²
-    out_of_window: int  # slaves whose nearest segment lay at the edge of their window
+    rows: list[np.ndarray]  # per active slave: its 4 DOF blocks
+    forces: list[np.ndarray]  # per active slave: (8,) ∂Π/∂X
+    tangents: list[np.ndarray]  # per active slave: (8, 8) ∂²Π/∂X²
 
 
 def evaluate(pair: ContactPair, x_cur: np.ndarray, want_tangent: bool = True) -> ContactState:
     """Gaps, pressures, forces and tangents at current node positions ``x_cur`` (blocks, 2)."""
     ns = len(pair.slave)
     gaps = np.zeros(ns)
+    slips = np.zeros(ns)
     rows, forces, tangents = [], [], []
-    out = 0
-    xm = x_cur[pair.master]
     for i in range(ns):
-        xs = x_cur[pair.slave[i]]
-        lo, hi = pair.window[i]
-        best = None
-        for seg in range(lo, hi + 1):
-            x1, x2 = xm[seg], xm[seg + 1]
-            a = x2 - x1
-            xi = (xs - x1) @ a / (a @ a)
-            dist = np.linalg.norm(xs - (x1 + np.clip(xi, 0.0, 1.0) * a))
-            if best is None or dist < best[0] - 1e-14:
-                best = (dist, seg)
-        seg = best[1]
-        if (seg == lo and lo > 0) or (seg == hi and hi < len(pair.master) - 2):
-            x1, x2 = xm[seg], xm[seg + 1]
-            xi = (xs - x1) @ (x2 - x1) / ((x2 - x1) @ (x2 - x1))
-            if xi < 0.0 or xi > 1.0:
-                out += 1
-        g, dg, d2g = gap_with_derivatives(xs, xm[seg], xm[seg + 1])
+        blocks = pair.blocks(i)
+        xs, x0, x1, x2 = x_cur[blocks]
+        g, dg, d2g = gap_with_derivatives(xs, x0, x1, x2)
+        t = (x2 - x1) / np.linalg.norm(x2 - x1)
         gaps[i] = g
+        slips[i] = (xs - x0) @ t
         if g < 0.0:
             kw = pair.penalty * pair.width * pair.weight[i]
-            rows.append(np.array([pair.slave[i], pair.master[seg], pair.master[seg + 1]]))
+            rows.append(blocks)
             forces.append(kw * g * dg)
             if want_tangent:
                 tangents.append(kw * (np.outer(dg, dg) + g * d2g))
     pressure = pair.penalty * np.maximum(-gaps, 0.0)
-    return ContactState(gaps, pressure, rows, forces, tangents, out)
+    return ContactState(gaps, slips, pressure, rows, forces, tangents)
 
 
 def slave_weights(x_ref: np.ndarray, x_left_tip: float, x_right_tip: float) -> np.ndarray:
@@ -111,6 +110,8 @@ def slave_weights(x_ref: np.ndarray, x_left_tip: float, x_right_tip: float) -> n
     and carry no contact: they are bonded).
     """
     xs = np.concatenate([[x_left_tip], np.sort(x_ref), [x_right_tip]])
+    if len(xs) % 2 == 0:
+        raise ValueError("face-lip nodes must alternate mid-side / corner between the tips")
     w = np.zeros(len(xs))
     for e in range(0, len(xs) - 2, 2):
         h = xs[e + 2] - xs[e]

@@ -31,11 +31,21 @@ class MumpsFactorization:
         pc = self.ksp.getPC()
         pc.setType("cholesky")
         pc.setFactorSolverType("mumps")
+        # the model reuses its matrix for the next tangent: never refactor this one silently
+        pc.setReusePreconditioner(True)
         pc.setFactorSetUpSolverType()
         F = pc.getFactorMatrix()
         F.setMumpsIcntl(13, 1)  # no ScaLAPACK root: INFOG(12) counts every negative pivot
         F.setMumpsIcntl(14, 80)  # working space +80 %
-        self.ksp.setUp()
+        F.setMumpsIcntl(24, 1)  # detect null pivots (reported in INFOG(28))
+        try:
+            self.ksp.setUp()
+        except PETSc.Error as exc:
+            raise ArithmeticError(f"MUMPS factorisation failed (error {exc.ierr})") from None
+        if F.getMumpsInfog(1) < 0:
+            raise ArithmeticError(f"MUMPS factorisation failed, INFOG(1) = {F.getMumpsInfog(1)}")
+        if F.getMumpsInfog(28) > 0:
+            raise ArithmeticError(f"singular tangent: {F.getMumpsInfog(28)} null pivot(s)")
         self._neg = int(F.getMumpsInfog(12))
         self.x, self.b = K.createVecs()
 
@@ -124,6 +134,12 @@ class Reference2DSystem:
         fem_petsc.assemble_matrix(A, self.J_form)
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+        # PETSc drops pattern slots that stay unfilled at a final assembly: touch every
+        # potential contact block with zeros, then add the active ones
+        for blocks in self._contact_blocks:
+            dofs = (self.bs * blocks[:, None] + np.arange(self.bs)).ravel().astype(np.int32)
+            A.setValuesLocal(dofs, dofs, np.zeros((len(dofs), len(dofs))),
+                             addv=PETSc.InsertMode.ADD_VALUES)
         for state, _pair in self._contact_states(want_tangent=True):
             for rows, k in zip(state.rows, state.tangents, strict=True):
                 dofs = (self.bs * rows[:, None] + np.arange(self.bs)).ravel().astype(np.int32)
@@ -166,12 +182,12 @@ class Reference2DSystem:
 
     def _create_matrix(self) -> PETSc.Mat:
         sp = fem.create_sparsity_pattern(self.J_form)
+        self._contact_blocks = []
         for pair in self.contacts:
-            nm = len(pair.master)
-            for i, s in enumerate(pair.slave):
-                lo, hi = pair.window[i]
-                blocks = np.concatenate([[s], pair.master[lo:min(hi + 2, nm)]]).astype(np.int32)
+            for i in range(len(pair.slave)):
+                blocks = pair.blocks(i).astype(np.int32)
                 sp.insert(blocks, blocks)
+                self._contact_blocks.append(blocks)
         sp.assemble()
         A = cpp.la.petsc.create_matrix(self.comm, sp)
         A.setOption(PETSc.Mat.Option.SYMMETRIC, True)

@@ -1,0 +1,206 @@
+"""A scene as a 2D model: layer bands, supports, dead loads, probes and debond contact on a mesh.
+
+The mesh is a ``meshes.LayeredMesh`` (or any object with the same arrays: ``points``, ``cells``
+in gmsh quad9 order and ``lip_pairs``). Everything else is located geometrically from the scene,
+in mm, with z = 0 at the core mid-plane:
+
+- supports act on the face's end section x = x_s, h_face wide: "roller" fixes w on every node of
+  the section, "pin" fixes w on every node and u on the node at the face's mid-surface, "clamp"
+  fixes u and w on every node (the core's section is free);
+- a patch load is a uniform dead traction on the loaded face's outer edge over [x − w/2, x + w/2],
+  scaled so that it carries exactly the scene's total force; a point load is a nodal force at the
+  outer-edge node nearest to x;
+- a probe is w at (x, z of the face's mid-surface), evaluated with the Q2 basis of the cell
+  containing that point, so it is a linear functional c · u.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem, geometry
+
+from reference2d import contact as ct
+from reference2d.constitutive import LayerBand, PlaneStressStiffness, internal_work
+from reference2d.loads import edge_facets, edge_length, edge_load_vector
+from reference2d.mesh import Discretisation, build_discretisation
+from reference2d.system import Reference2DSystem
+from sandwich.scene import Scene
+
+GEOM_TOL = 1e-7  # mm: coordinates closer than this are the same point
+
+
+def layer_bands(scene: Scene) -> list[LayerBand]:
+    """Bottom face, core and top face as z-bands (mm)."""
+    hc = scene.core.thickness
+    return [
+        LayerBand("bottom", -0.5 * hc - scene.bottom.thickness, -0.5 * hc, scene.bottom.material),
+        LayerBand("core", -0.5 * hc, 0.5 * hc, scene.core.material),
+        LayerBand("top", 0.5 * hc, 0.5 * hc + scene.top.thickness, scene.top.material),
+    ]
+
+
+def face_band(scene: Scene, face: str) -> LayerBand:
+    """The band of face "top" or "bottom"."""
+    return {b.name: b for b in layer_bands(scene)}[face]
+
+
+def outer_z(scene: Scene, face: str) -> float:
+    """z of a face's outer edge (mm)."""
+    band = face_band(scene, face)
+    return band.z_hi if face == "top" else band.z_lo
+
+
+def interface_z(scene: Scene, interface: str) -> float:
+    """z of the face/core interface "top" or "bottom" (mm)."""
+    return 0.5 * scene.core.thickness * (1.0 if interface == "top" else -1.0)
+
+
+def default_penalty(scene: Scene) -> float:
+    """Contact penalty k (N/mm³): twice the stiffest face's through-thickness stiffness E_z / h.
+
+    A contact pressure p then penetrates p / k, i.e. 1e-3 × the face thickness at p ≈ E_z / 500
+    (≈ 55 MPa for the paper's faces), far above the pressures these scenes reach.
+    """
+    return max(2.0 * lay.material.Ez / lay.thickness for lay in (scene.top, scene.bottom))
+
+
+@dataclass
+class Model2D:
+    """Everything the solve needs: the discretisation, the system and what to sample."""
+
+    scene: Scene
+    mesh: object
+    disc: Discretisation
+    stiffness: PlaneStressStiffness
+    system: Reference2DSystem
+    contact_pairs: list[ct.ContactPair]
+    contact_interfaces: list[str]
+    penalty: float
+
+
+def build_model(scene: Scene, mesh, penalty: float | None = None) -> Model2D:
+    """Assemble the 2D model of ``scene`` on ``mesh`` (a LayeredMesh)."""
+    disc = build_discretisation(mesh.points, mesh.cells)
+    V = disc.V
+    bands = layer_bands(scene)
+    stiffness = PlaneStressStiffness(disc.mesh, bands)
+    n_local = (V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts) * 2
+    X = V.tabulate_dof_coordinates()[:, :2]
+    bc = support_dofs(scene, X)
+    f_ref = load_vector(scene, V, X, n_local)
+    probes = {p.name: probe_vector(V, p.x, face_band(scene, p.on), n_local)
+              for p in scene.probes}
+    k = penalty if penalty is not None else (scene.reference2d.contact_penalty
+                                             or default_penalty(scene))
+    pairs, ifaces = contact_pairs(scene, mesh, disc, k)
+    system = Reference2DSystem(
+        V, lambda u, v: internal_work(u, v, stiffness, scene.width), f_ref, bc, pairs, probes)
+    return Model2D(scene, mesh, disc, stiffness, system, pairs, ifaces, k)
+
+
+def support_dofs(scene: Scene, X: np.ndarray) -> np.ndarray:
+    """Unrolled local DOF indices fixed by the scene's supports (u: 2 i, w: 2 i + 1)."""
+    fixed: list[np.ndarray] = []
+    for s in scene.supports:
+        for face in s.faces:
+            band = face_band(scene, face)
+            section = np.where((np.abs(X[:, 0] - s.x) < GEOM_TOL)
+                               & (X[:, 1] > band.z_lo - GEOM_TOL)
+                               & (X[:, 1] < band.z_hi + GEOM_TOL))[0]
+            if len(section) == 0:
+                raise ValueError(f"support at x = {s.x} on the {face} face: no mesh node there")
+            fixed.append(2 * section + 1)  # w on the whole section
+            if s.type == "clamp":
+                fixed.append(2 * section)
+            elif s.type == "pin":
+                z_mid = 0.5 * (band.z_lo + band.z_hi)
+                fixed.append(2 * section[[np.argmin(np.abs(X[section, 1] - z_mid))]])
+    return np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, dtype=np.int64)
+
+
+def load_vector(scene: Scene, V, X: np.ndarray, n_local: int) -> np.ndarray:
+    """Reference load (λ = 1) of every scene load, on the local DOFs."""
+    f = np.zeros(n_local)
+    for ld in scene.loads:
+        z = outer_z(scene, ld.on)
+        if ld.width > 0:
+            a, b = ld.span
+
+            def on_patch(x, a=a, b=b, z=z):
+                return ((np.abs(x[1] - z) < GEOM_TOL) & (x[0] > a - GEOM_TOL)
+                        & (x[0] < b + GEOM_TOL))
+
+            facets = edge_facets(V.mesh, on_patch)
+            length = edge_length(V.mesh, facets)
+            if length <= 0.0:
+                raise ValueError(f"load at x = {ld.x} on the {ld.on} face: no edge under it")
+            t_z = ld.force / (length * scene.width)  # MPa, total force exactly ld.force
+            f += edge_load_vector(V, facets, (0.0, t_z), scene.width, n_local)
+        else:
+            edge = np.where(np.abs(X[:, 1] - z) < GEOM_TOL)[0]
+            node = edge[np.argmin(np.abs(X[edge, 0] - ld.x))]
+            f[2 * node + 1] += ld.force
+    return f
+
+
+def probe_vector(V, x: float, band: LayerBand, n_local: int) -> np.ndarray:
+    """c with c · u = w(x, z_mid) of the face ``band`` (Q2 interpolation in its cell)."""
+    msh = V.mesh
+    z_mid = 0.5 * (band.z_lo + band.z_hi)
+    point = np.array([[x, z_mid, 0.0]])
+    tree = geometry.BoundingBoxTree(msh, msh.topology.dim)
+    cells = geometry.compute_colliding_cells(msh, geometry.compute_collisions(tree, point), point)
+    c = np.zeros(n_local)
+    if len(cells.links(0)) == 0:
+        return c  # the point lives on another rank
+    cell = cells.links(0)[0]
+    e = fem.Function(V)
+    for blk in V.dofmap.cell_dofs(cell):
+        e.x.array[:] = 0.0
+        e.x.array[2 * blk + 1] = 1.0
+        c[2 * blk + 1] = e.eval(point, [cell])[1]
+    return c
+
+
+def contact_pairs(scene: Scene, mesh, disc: Discretisation, penalty: float) -> tuple[list[ct.ContactPair], list[str]]:
+    """Node-to-segment contact data of every debond that has lip nodes."""
+    pairs, ifaces = [], []
+    lip_pairs = getattr(mesh, "lip_pairs", {}) or {}
+    pts = np.asarray(mesh.points)[:, :2]
+    for i, debond in enumerate(scene.debonds):
+        if i not in lip_pairs or len(lip_pairs[i]) == 0:
+            continue
+        nodes = np.asarray(lip_pairs[i])
+        face_nodes, core_nodes = nodes[:, 0], nodes[:, 1]
+        z = interface_z(scene, debond.interface)
+        order = np.argsort(pts[core_nodes, 0])
+        core_sorted = core_nodes[order]
+        lip_set = set(map(int, nodes.ravel()))
+        tips = []
+        for x_tip in (debond.start, debond.end):
+            hit = np.where((np.abs(pts[:, 0] - x_tip) < GEOM_TOL)
+                           & (np.abs(pts[:, 1] - z) < GEOM_TOL))[0]
+            hit = [h for h in hit if int(h) not in lip_set]
+            tips.append(hit[0] if hit else None)
+        chain = ([tips[0]] if tips[0] is not None else []) + list(core_sorted) + (
+            [tips[1]] if tips[1] is not None else [])
+        if debond.interface == "bottom":
+            chain = chain[::-1]  # so that n = J (x2 − x1)/|…| points out of the core (−z)
+        master = disc.blocks(np.array(chain))
+        slave = disc.blocks(face_nodes)
+        position = {int(blk): k for k, blk in enumerate(master)}
+        anchor = disc.blocks(core_nodes)
+        chord = np.zeros((len(slave), 2), dtype=np.int32)
+        for j, blk in enumerate(anchor):
+            k = position[int(blk)]
+            chord[j] = (master[max(k - 1, 0)], master[min(k + 1, len(master) - 1)])
+        x_face = pts[face_nodes, 0]
+        x_lo = pts[chain[0], 0] if tips[0] is not None else x_face.min()
+        x_hi = pts[chain[-1], 0] if tips[1] is not None else x_face.max()
+        x_lo, x_hi = min(x_lo, x_hi), max(x_lo, x_hi)
+        weight = ct.slave_weights(x_face, x_lo, x_hi)
+        pairs.append(ct.ContactPair(slave, anchor, chord, weight, penalty, scene.width, x_face))
+        ifaces.append(debond.interface)
+    return pairs, ifaces
