@@ -206,7 +206,13 @@ class _Follower:
             return self.finish(False, "step 1: f_ref is zero or the linear solution is not finite")
         self.psi = opt.arc_load_weight * tn
         self.lam_est = self._target_load_estimate(t)
-        h = opt.initial_increment or self._auto_increment(t)
+        h = opt.initial_increment
+        if h is None:  # automatic, kept within the bounds the user gave
+            h = self._auto_increment(t)
+            if opt.max_increment is not None:
+                h = min(h, opt.max_increment)
+            if opt.min_increment is not None:
+                h = max(h, opt.min_increment)
         h_min = opt.min_increment if opt.min_increment is not None else 1e-4 * h
         h_max = opt.max_increment if opt.max_increment is not None else 10.0 * h
         if not (0.0 < h_min <= h <= h_max):
@@ -244,8 +250,9 @@ class _Follower:
                                 "control.")
                     return self.finish(False, (
                         f"step {step}: no convergence from λ = {last.load_factor:.6g} "
-                        f"({_fmt_probes(last.probes)}) with the {opt.control} increment cut "
-                        f"{cuts} times down to {h_try:.3g} (min_increment {h_min:.3g}); "
+                        f"({_fmt_probes(last.probes)}): the {opt.control} increment was cut "
+                        f"{cuts} time(s), last to {h_try:.3g}, and may not go below "
+                        f"min_increment = {h_min:.3g}; "
                         f"last reason: {reason}.{hint}"))
             crossed = ""
             if not direct:

@@ -81,7 +81,7 @@ class SparseFactorization:
             raise SingularTangentError("tangent is the zero matrix")
         self._negative = None
         self.pivoted = True
-        lu = self._ldlt(A, kmax)
+        lu = self._ldlt(A, kmax, singular_rtol)
         if lu is not None:
             self._negative = int(np.count_nonzero(lu.U.diagonal() < 0.0))
             self.pivoted = False
@@ -90,7 +90,7 @@ class SparseFactorization:
         self._lu = lu
 
     @staticmethod
-    def _ldlt(A: sp.csc_matrix, kmax: float) -> spla.SuperLU | None:
+    def _ldlt(A: sp.csc_matrix, kmax: float, singular_rtol: float) -> spla.SuperLU | None:
         """Pivot-free factorisation, or ``None`` when it is unusable for the inertia."""
         try:
             lu = spla.splu(
@@ -107,8 +107,8 @@ class SparseFactorization:
         ):
             return None  # SuperLU had to interchange rows (zero diagonal pivot)
         d = lu.U.diagonal()
-        if not np.all(np.isfinite(d)) or np.any(d == 0.0):
-            return None
+        if not np.all(np.isfinite(d)) or np.min(np.abs(d)) <= singular_rtol * n * kmax:
+            return None  # tiny pivot: unstable elimination or singular, the LU below decides
         # U has the units of K, L (unit lower triangular) is dimensionless
         growth = max(np.max(np.abs(lu.U.data)) / kmax, np.max(np.abs(lu.L.data)))
         if not np.isfinite(growth) or growth > GROWTH_LIMIT:
