@@ -1,0 +1,212 @@
+"""Solve a scene with the beam element: linear, or nonlinear path following.
+
+:func:`solve` returns the project's common :class:`~sandwich.results.Solution` (model "beam");
+:func:`run` also hands back the model and the converged states, for field reconstruction
+(:mod:`beam_element.fields`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from beam_element.contact import NORMAL_SIGN
+from beam_element.fields import profile_columns
+from beam_element.model import BeamModel, build_model
+from beam_element.quadrature import EXACT_ORDER
+from sandwich.results import LimitPoint, Profile, Solution, StepRecord
+
+MAX_ACTIVE_SET_PASSES = 50
+
+
+@dataclass(frozen=True)
+class ConvergedState:
+    """A converged equilibrium state on the free DOFs."""
+
+    step: int
+    load_factor: float
+    u: np.ndarray
+    iterations: int
+    probes: dict[str, float]
+
+
+@dataclass
+class BeamRun:
+    """A solve's result with the model and every converged state."""
+
+    solution: Solution
+    model: BeamModel
+    states: list[ConvergedState]
+    nonlinear: bool
+
+
+def _gauss_orders(scene: object) -> dict[str, tuple[int, int]]:
+    """Per-layer Gauss orders: the exact rule, raised (never lowered) by the scene's options."""
+    opts = getattr(scene, "beam_model", None)
+    gx, gz = getattr(opts, "gauss_x", None), getattr(opts, "gauss_z", None)
+    orders = {}
+    for layer, (nx, nz) in EXACT_ORDER.items():
+        orders[layer] = (max(nx, gx or 0), max(nz, gz or 0))
+    return orders
+
+
+def _linear_contact_matrix(model: BeamModel, active: list[np.ndarray]) -> sp.csr_matrix:
+    """Penalty stiffness of the linearised gap g ≈ s_n (w_face − w_core) on active pairs."""
+    n = model.dof_map.n_full
+    K = sp.csr_matrix((n, n))
+    for pairs, on in zip(model.pairs, active, strict=True):
+        s_n = NORMAL_SIGN[pairs.interface]
+        grad = np.array([0.0, s_n, 0.0, -s_n, 0.0, 0.0])  # ∂g_lin/∂(pair DOFs)
+        blocks = (model.penalty * pairs.area * on)[:, None, None] * np.outer(grad, grad)
+        rows = np.repeat(pairs.dofs[:, :, None], 6, axis=2)
+        cols = np.repeat(pairs.dofs[:, None, :], 6, axis=1)
+        K = K + sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(n, n))
+    T = model.dof_map.T
+    return (T.T @ K @ T).tocsr()
+
+
+def linear_solution(model: BeamModel, load_factor: float) -> tuple[np.ndarray, int]:
+    """Small-displacement solution at ``load_factor`` with unilateral contact on debonds.
+
+    The tangent at u = 0 plus the penalty on the linearised gap of the pairs in contact; the
+    active set is iterated to a fixed point. Returns the free DOFs and the number of passes.
+    """
+    K0 = model.tangent(np.zeros(model.size))
+    f = load_factor * model.f_ref
+    active = [np.zeros(p.size, dtype=bool) for p in model.pairs]
+    for passes in range(1, MAX_ACTIVE_SET_PASSES + 1):
+        fac = model.factorize(K0 + _linear_contact_matrix(model, active))
+        u = np.asarray(fac.solve(f), dtype=float)
+        u_full = model.expand(u)
+        new = []
+        for pairs in model.pairs:
+            v = u_full[pairs.dofs]
+            new.append(NORMAL_SIGN[pairs.interface] * (v[:, 1] - v[:, 3]) < 0.0)
+        if all(np.array_equal(a, b) for a, b in zip(active, new, strict=True)):
+            return u, passes
+        active = new
+    raise RuntimeError(
+        f"linear contact active set did not settle in {MAX_ACTIVE_SET_PASSES} passes"
+    )
+
+
+def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState], str]:
+    a = scene.analysis
+    names = list(model.probe_rows)
+    probe = {n: model.probe_vector(n) for n in names}
+    zero = ConvergedState(0, 0.0, np.zeros(model.size), 0, {n: 0.0 for n in names})
+    if a.until_probe is not None:
+        for sign in (1.0, -1.0):  # unilateral contact: the response is homogeneous for λ > 0
+            u1, passes = linear_solution(model, sign)
+            value = float(probe[a.until_probe] @ u1)
+            if value * a.until_value > 0:
+                λ = sign * a.until_value / value
+                u = u1 * (λ / sign)
+                break
+        else:
+            raise ValueError(f"probe {a.until_probe!r} does not move under the scene's loads")
+        message = f"linear solution scaled to {a.until_probe} = {a.until_value:g}"
+    else:
+        λ = a.until_load_factor if a.until_load_factor is not None else 1.0
+        u, passes = linear_solution(model, λ)
+        message = f"linear solution at load factor {λ:g}"
+    state = ConvergedState(1, float(λ), u, passes, {n: float(probe[n] @ u) for n in names})
+    model.commit(u, λ)
+    return [zero, state], message
+
+
+def run(
+    scene: object,
+    progress: Callable[[object], None] | None = None,
+    *,
+    elements: int | None = None,
+) -> BeamRun:
+    """Build the beam model of ``scene``, solve it, and return solution, model and states.
+
+    Parameters
+    ----------
+    scene
+        A :class:`sandwich.scene.Scene`.
+    progress
+        Per-step callback of the path follower (nonlinear analyses).
+    elements
+        Target element count (default ``scene.beam_model.elements``).
+    """
+    t0 = time.perf_counter()
+    a = scene.analysis
+    if a.kind not in ("linear", "nonlinear"):
+        raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
+    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene))
+    nonlinear = a.kind == "nonlinear"
+    limit_points: list[LimitPoint] = []
+    if not nonlinear:
+        states, message = _linear_states(model, scene)
+        converged = True
+    else:
+        from sandwich.solver.path import PathOptions, follow_path
+
+        options = PathOptions(
+            control=a.control, until_load_factor=a.until_load_factor, until_probe=a.until_probe,
+            until_value=a.until_value, max_steps=a.max_steps,
+            initial_increment=a.initial_increment, min_increment=a.min_increment,
+            max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations,
+        )
+        result = follow_path(model, options, list(model.probe_rows), progress)
+        states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
+                  for s in result.states]
+        message, converged = result.message, result.reached_target
+        limit_points = list(result.limit_points)
+    solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
+    solution.wall_seconds = time.perf_counter() - t0
+    return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def solve(scene: object, progress: Callable[[object], None] | None = None) -> Solution:
+    """Solve ``scene`` with the beam element; see :func:`run`."""
+    return run(scene, progress).solution
+
+
+def _solution(
+    scene: object, model: BeamModel, states: list[ConvergedState], nonlinear: bool,
+    converged: bool, message: str, limit_points: list[LimitPoint],
+) -> Solution:
+    history = []
+    max_pen = max_slide = 0.0
+    for s in states:
+        summary = model.contact_summary(s.u) if nonlinear else {}
+        pen = max((c.max_penetration for c in summary.values()), default=0.0)
+        slide = max((c.max_sliding for c in summary.values()), default=0.0)
+        max_pen, max_slide = max(max_pen, pen), max(max_slide, slide)
+        extra = {"max_penetration": pen, "max_sliding": slide,
+                 "contact_pairs_active": float(sum(c.active for c in summary.values()))}
+        history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
+                                  iterations=s.iterations, extra=extra))
+    every = int(getattr(getattr(scene, "beam_model", None), "profile_every", 0) or 0)
+    chosen = [s for s in states if every and s.step % every == 0 and s is not states[-1]]
+    chosen.append(states[-1])
+    profiles = [Profile(step=s.step, columns=profile_columns(model, s.u, nonlinear))
+                for s in chosen]
+    bound = model.penetration_bound()
+    if max_pen > bound:
+        message += (f"; WARNING: contact penetration {max_pen:.3g} mm exceeds "
+                    f"{bound:.3g} mm (raise beam_model.contact_penalty)")
+    return Solution(
+        model="beam", scene=scene.name, history=history, profiles=profiles, converged=converged,
+        message=message, limit_points=limit_points, wall_seconds=0.0, dofs=model.size,
+        extra={
+            "elements": model.mesh.n_elements,
+            "nodes": model.mesh.n_nodes,
+            "analysis": "nonlinear" if nonlinear else "linear",
+            "gauss": {k: list(v) for k, v in _gauss_orders(scene).items()},
+            "contact_pairs": int(sum(p.size for p in model.pairs)),
+            "contact_penalty": model.penalty,
+            "max_penetration": max_pen,
+            "penetration_bound": bound,
+            "max_sliding": max_slide,
+            "total_newton_iterations": int(sum(s.iterations for s in states)),
+        },
+    )
