@@ -52,11 +52,16 @@ def profile_columns(n_x: int, w_end: float, scale: float) -> dict[str, np.ndarra
 def make_solution(model: str, *, eps: float = 0.0, n_steps: int = 150, n_x: int = 301,
                   wall: float = 1.0, dofs: int = 100, probe_eps: float | None = None,
                   profile_steps: tuple[int, ...] = (-1,), scene: str = "synthetic",
-                  progress=None) -> Solution:
-    """A synthetic path and profiles; ``eps`` scales load and profiles by (1 + eps)."""
+                  progress=None, load_fn=None, columns: dict | None = None,
+                  drop: tuple[str, ...] = ()) -> Solution:
+    """A synthetic path and profiles; ``eps`` scales load and profiles by (1 + eps).
+
+    ``load_fn(|w|)`` replaces λ(w); ``columns`` maps profile names to functions of x that
+    replace (or add) columns; ``drop`` removes optional columns.
+    """
     probe_eps = eps if probe_eps is None else probe_eps
     w = np.linspace(0.0, W_END, n_steps + 1)[1:]
-    lam = (1 + eps) * load_of(w)
+    lam = (1 + eps) * (load_of(w) if load_fn is None else load_fn(np.abs(w)))
     history = []
     for i, (wi, li) in enumerate(zip(w, lam, strict=True)):
         rec = StepRecord(step=i + 1, load_factor=float(li),
@@ -67,15 +72,27 @@ def make_solution(model: str, *, eps: float = 0.0, n_steps: int = 150, n_x: int 
         if progress is not None:
             progress(SimpleNamespace(step=rec.step, load_factor=rec.load_factor,
                                      probes=rec.probes))
-    profiles = [Profile(step=history[k].step,
-                        columns=profile_columns(n_x, history[k].probes["w_top_mid"], 1 + eps))
-                for k in profile_steps]
+    profiles = []
+    for k in profile_steps:
+        cols = profile_columns(n_x, history[k].probes["w_top_mid"], 1 + eps)
+        for name, fn in (columns or {}).items():
+            cols[name] = fn(cols["x"])
+        for name in drop:
+            cols.pop(name)
+        profiles.append(Profile(step=history[k].step, columns=cols))
     i_max = int(np.argmax(lam))
     limits = [LimitPoint("max", history[i_max].step, float(lam[i_max]),
                          dict(history[i_max].probes))]
     return Solution(model=model, scene=scene, history=history, profiles=profiles,
                     converged=True, message="reached until probe", limit_points=limits,
                     wall_seconds=wall, dofs=dofs, extra={"level": "medium"})
+
+
+def scene_copy(stem: str, folder: Path):
+    """Load a private copy of ``scenes/<stem>.toml`` from ``folder``."""
+    dst = folder / f"{stem}.toml"
+    shutil.copy(ROOT / "scenes" / f"{stem}.toml", dst)
+    return load_scene(dst)
 
 
 @pytest.fixture
@@ -92,7 +109,8 @@ def scene(scene_file: Path):
 
 
 def fake_solvers(eps: float, *, wall_beam: float = 0.5, wall_2d: float = 20.0,
-                 dofs_beam: int = 2400, dofs_2d: int = 96000, calls: list | None = None):
+                 dofs_beam: int = 2400, dofs_2d: int = 96000, calls: list | None = None,
+                 per_scene=None):
     """Solve functions returning the synthetic solutions (beam = 2D × (1 + eps)).
 
     The beam profiles are sampled every 0.5 mm, a refinement of the 2D 1 mm stations, so that
@@ -103,13 +121,15 @@ def fake_solvers(eps: float, *, wall_beam: float = 0.5, wall_2d: float = 20.0,
         if calls is not None:
             calls.append("2d")
         return make_solution("2d", n_steps=150, n_x=301, wall=wall_2d, dofs=dofs_2d,
-                             scene=scene.name, progress=progress)
+                             scene=scene.name, progress=progress,
+                             **(per_scene(scene) if per_scene else {}))
 
     def solve_beam(scene, progress=None):
         if calls is not None:
             calls.append("beam")
         return make_solution("beam", eps=eps, n_steps=97, n_x=601, wall=wall_beam,
-                             dofs=dofs_beam, scene=scene.name, progress=progress)
+                             dofs=dofs_beam, scene=scene.name, progress=progress,
+                             **(per_scene(scene) if per_scene else {}))
 
     return {"2d": solve_2d, "beam": solve_beam}
 
@@ -117,6 +137,7 @@ def fake_solvers(eps: float, *, wall_beam: float = 0.5, wall_2d: float = 20.0,
 @pytest.fixture
 def synth():
     """The synthetic factories of this module."""
-    return SimpleNamespace(make_solution=make_solution, fake_solvers=fake_solvers,
+    return SimpleNamespace(make_solution=make_solution, scene_copy=scene_copy,
+                           fake_solvers=fake_solvers,
                            analytic_limit=analytic_limit, load_of=load_of, K=K, C=C,
                            W_END=W_END, TIPS=TIPS)
