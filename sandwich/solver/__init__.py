@@ -3,6 +3,7 @@
 The solver never knows which physics it drives: it sees a :class:`DiscreteSystem`.
 """
 
+from sandwich.solver.limits import find_limit_points
 from sandwich.solver.newton import NewtonResult, NewtonSettings, newton_correct, solve_equilibrium
 from sandwich.solver.path import PathOptions, PathResult, PathState, follow_path, solve_linear
 from sandwich.solver.sparse import (
@@ -25,6 +26,7 @@ __all__ = [
     "SparseFactorization",
     "SparseSystemMixin",
     "factorize_symmetric",
+    "find_limit_points",
     "follow_path",
     "newton_correct",
     "solve_equilibrium",
