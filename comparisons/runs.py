@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from comparisons.reading import RESULT_FILES, ResultMissing, load_result
+from comparisons.snapshots import SNAPSHOT_FILE, beam_solver_with_fields, save_snapshot
 from sandwich.results import Solution, write_solution
 from sandwich.scene import Scene
 
@@ -110,6 +111,8 @@ def import_solver(model: str) -> Solver:
     solve = getattr(module, "solve", None)
     if not callable(solve):
         raise ImportError(f"model '{model}': {module_name} has no solve() yet")
+    if model == BEAM:  # keep the section's 2D fields for the deformed pictures when offered
+        return beam_solver_with_fields(module) or solve
     return solve
 
 
@@ -170,7 +173,12 @@ def obtain(scene: Scene, model: str, *, results_root: Path, reuse: bool = True,
         return ModelRun(model, folder, "failed", None, reason=reason,
                         seconds=time.perf_counter() - t0)
     seconds = time.perf_counter() - t0
+    snapshot = solution.extra.pop("field_snapshot", None)  # arrays: fields.npz, not summary.json
     write_solution(solution, folder)
+    if snapshot is not None:
+        save_snapshot(snapshot, folder)
+    elif (folder / SNAPSHOT_FILE).exists():
+        (folder / SNAPSHOT_FILE).unlink()  # a stale picture of an older run
     say(ProgressEvent(model, "done", step=len(solution.history),
                       load_factor=solution.final_load_factor, message=solution.message))
     return ModelRun(model, folder, "run", solution, seconds=seconds)

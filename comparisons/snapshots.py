@@ -6,12 +6,17 @@ The one place that knows where a model's 2D field data lives. A model provides a
 ``displacement``, ``cells``, ``von_mises``, optional ``region``, scalars ``step``,
 ``load_factor``). Without it the pictures fall back to the face deflections of ``profiles.csv``
 (:func:`face_lines`).
+
+Known sources: the beam model's ``beam_element.run`` + ``section_fields`` (a structured grid of
+the section with per-point von Mises), wrapped by :func:`beam_solver_with_fields`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
@@ -125,3 +130,43 @@ def face_lines(scene: Scene, profile: Profile, model: str) -> FaceLines:
     return FaceLines(model, x, z_top0 + np.asarray(c["w_top"])[order],
                      z_bottom0 + np.asarray(c["w_bottom"])[order],
                      np.asarray(c["tau_core"])[order])
+
+
+def snapshot_from_section(model: str, step: int, load_factor: float,
+                          fields: object) -> FieldSnapshot:
+    """Build a :class:`FieldSnapshot` from fields such as ``beam_element.SectionFields``.
+
+    ``fields`` needs ``points, displacement, cells, von_mises`` and may have ``region``.
+    """
+    return FieldSnapshot(model=model, step=step, load_factor=load_factor,
+                         points=np.asarray(fields.points, dtype=float),  # type: ignore[attr-defined]
+                         displacement=np.asarray(fields.displacement,  # type: ignore[attr-defined]
+                                                 dtype=float),
+                         cells=np.asarray(fields.cells, dtype=int),  # type: ignore[attr-defined]
+                         von_mises=np.asarray(fields.von_mises,  # type: ignore[attr-defined]
+                                              dtype=float),
+                         region=getattr(fields, "region", None))
+
+
+def beam_solver_with_fields(module: ModuleType) -> Callable[..., Solution] | None:
+    """``solve`` for the beam model that also keeps the section fields of the last state.
+
+    Uses ``module.run`` (solution, model, states) and ``module.section_fields``; returns ``None``
+    when the module does not offer them (the caller then uses plain ``solve``). The snapshot is
+    put into ``solution.extra["field_snapshot"]``; the harness moves it into ``fields.npz``.
+    """
+    run, fields = getattr(module, "run", None), getattr(module, "section_fields", None)
+    if not callable(run) or not callable(fields):
+        return None
+
+    def solve(scene: Scene, progress: Callable[[object], None] | None = None) -> Solution:
+        result = run(scene, progress)
+        solution = result.solution
+        if result.states:
+            last = result.states[-1]
+            section = fields(result.model, last.u, nonlinear=result.nonlinear)
+            solution.extra["field_snapshot"] = snapshot_from_section(
+                solution.model or "beam", last.step, last.load_factor, section)
+        return solution
+
+    return solve

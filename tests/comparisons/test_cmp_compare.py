@@ -151,12 +151,25 @@ def test_field_snapshot_is_rendered_when_a_model_provides_it(tmp_path, scene, sy
         return sol
 
     solvers["2d"] = with_fields
-    # summary.json cannot hold arrays: the snapshot must go through fields.npz, not extra
-    with pytest.raises(TypeError):
-        compare(scene, tmp_path / "o0", results_root=tmp_path / "r0", solvers=solvers)
+    # the in-memory snapshot goes to fields.npz (summary.json cannot hold arrays)
+    cmp = compare(scene, tmp_path / "o0", results_root=tmp_path / "r0", solvers=solvers)
+    assert (tmp_path / "r0" / scene.name / "2d" / "fields.npz").is_file()
+    assert "field_snapshot" not in (tmp_path / "r0" / scene.name / "2d" / "summary.json"
+                                    ).read_text()
+    assert tmp_path / "o0" / "deformed_2d.png" in cmp.figures
+    # a snapshot saved next to a result (as a model would) is used too
     save_snapshot(_strip_snapshot("beam"), tmp_path / "res" / scene.name / "beam")
-    cmp = compare(scene, tmp_path / "out", results_root=tmp_path / "res",
-                  solvers=synth.fake_solvers(EPS))
+    plain = synth.fake_solvers(EPS)
+    compare(scene, tmp_path / "x", results_root=tmp_path / "res", solvers=plain)
+    # ... but a rerun that gives no snapshot removes the stale one
+    assert not (tmp_path / "res" / scene.name / "beam" / "fields.npz").exists()
+    save_snapshot(_strip_snapshot("beam"), tmp_path / "res" / scene.name / "beam")
+    old = (tmp_path / "res" / scene.name / "beam" / "summary.json").stat().st_mtime - 100
+    import os
+
+    os.utime(scene.source, (old, old))
+    cmp = compare(scene, tmp_path / "out", results_root=tmp_path / "res", solvers=plain)
+    assert cmp.runs["beam"].origin == "reused"
     assert tmp_path / "out" / "deformed_beam.png" in cmp.figures
     assert (tmp_path / "out" / "deformed_beam.png").stat().st_size > 5000
     assert (tmp_path / "out" / "deformed_faces.png").is_file()  # 2D still from its profiles
