@@ -1,0 +1,96 @@
+"""Fields sampled along the beam at one state: face deflections, core interface stresses, contact.
+
+Stresses are second Piola–Kirchhoff components S = C : E in the reference (x, z) frame, as the beam
+element reports them: ``sigma_zz_top``/``sigma_zz_bottom`` is S_zz of the *core* at its top/bottom
+boundary (z = ±h_c/2, evaluated in the core cell), ``tau_core`` is S_xz at the core mid-plane.
+Stations are the x of the mesh nodes on the top interface.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from dolfinx import fem, geometry
+
+from reference2d.constitutive import green_lagrange
+from reference2d.model import Model2D, face_band
+
+GEOM_TOL = 1e-7
+
+
+class ProfileSampler:
+    """Evaluates the profile columns of :data:`sandwich.results.PROFILE_COLUMNS` (and more)."""
+
+    def __init__(self, model: Model2D):
+        self.model = model
+        scene = model.scene
+        msh = model.disc.mesh
+        pts = np.asarray(model.mesh.points)[:, :2]
+        hc = scene.core.thickness
+        on_iface = np.abs(pts[:, 1] - 0.5 * hc) < GEOM_TOL
+        self.x = np.unique(np.round(pts[on_iface, 0], 9))
+        self.core = [k for k, b in enumerate(_bands(model)) if b == "core"][0]
+        # the 2nd PK stress as a DG2 field (exact samples of S at the element's nodes)
+        W = fem.VectorFunctionSpace(msh, ("DG", 2), dim=3)
+        S = model.stiffness.pk2(green_lagrange(model.system.u))
+        self.S_expr = fem.Expression(ufl.as_vector([S[0, 0], S[1, 1], S[0, 1]]),
+                                     W.element.interpolation_points())
+        self.S = fem.Function(W)
+        self.tree = geometry.BoundingBoxTree(msh, msh.topology.dim)
+        zt = 0.5 * (face_band(scene, "top").z_lo + face_band(scene, "top").z_hi)
+        zb = 0.5 * (face_band(scene, "bottom").z_lo + face_band(scene, "bottom").z_hi)
+        self.rows = {
+            "w_top": (zt, None), "w_bottom": (zb, None),
+            "sigma_zz_top": (0.5 * hc, self.core), "sigma_zz_bottom": (-0.5 * hc, self.core),
+            "tau_core": (0.0, self.core),
+        }
+        self.cells = {k: self._cells(z, layer) for k, (z, layer) in self.rows.items()}
+
+    def _cells(self, z: float, layer: int | None) -> np.ndarray:
+        msh = self.model.disc.mesh
+        p = np.column_stack([self.x, np.full_like(self.x, z), np.zeros_like(self.x)])
+        coll = geometry.compute_colliding_cells(msh, geometry.compute_collisions(self.tree, p), p)
+        out = np.full(len(self.x), -1, dtype=np.int32)
+        for i in range(len(self.x)):
+            cand = coll.links(i)
+            if layer is not None:
+                cand = [c for c in cand if self.model.stiffness.layer_index[c] == layer]
+            if len(cand):
+                out[i] = cand[0]
+        return out
+
+    def sample(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        """Profile columns at state ``u`` (this also evaluates the contact state there)."""
+        system = self.model.system
+        system.commit(u, 0.0)
+        self.S.interpolate(self.S_expr)
+        cols = {"x": self.x.copy()}
+        for name, (z, _layer) in self.rows.items():
+            p = np.column_stack([self.x, np.full_like(self.x, z), np.zeros_like(self.x)])
+            cells = self.cells[name]
+            ok = cells >= 0
+            vals = np.zeros(len(self.x))
+            if name.startswith("w_"):
+                vals[ok] = system.u.eval(p[ok], cells[ok])[:, 1]
+            else:
+                comp = {"sigma_zz_top": 1, "sigma_zz_bottom": 1, "tau_core": 2}[name]
+                vals[ok] = self.S.eval(p[ok], cells[ok])[:, comp]
+            cols[name] = vals
+        for iface in ("top", "bottom"):
+            p_c = np.zeros(len(self.x))
+            for pair, state, where in zip(self.model.contact_pairs, system.last_contact,
+                                          self.model.contact_interfaces, strict=True):
+                if where != iface:
+                    continue
+                order = np.argsort(pair.x_ref)
+                xs, ps = pair.x_ref[order], state.pressure[order]
+                inside = (self.x >= xs[0] - GEOM_TOL) & (self.x <= xs[-1] + GEOM_TOL)
+                p_c[inside] += np.interp(self.x[inside], xs, ps)
+            cols[f"p_contact_{iface}"] = p_c
+        return cols
+
+
+def _bands(model: Model2D) -> list[str]:
+    from reference2d.model import layer_bands
+
+    return [b.name for b in layer_bands(model.scene)]

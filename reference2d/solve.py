@@ -1,0 +1,130 @@
+"""``solve(scene)``: the 2D reference on the equilibrium path, as a :class:`Solution`."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from reference2d.model import Model2D, build_model
+from reference2d.profiles import ProfileSampler
+from sandwich.results import Profile, Solution, StepRecord
+from sandwich.scene import Scene
+from sandwich.solver.path import PathOptions, PathState, follow_path, solve_linear
+
+MODEL_NAME = "2d"
+
+
+def build_scene_mesh(scene: Scene, level: str | None = None, refine: int | None = None):
+    """The scene's LayeredMesh from :mod:`meshes` (level/refine default to the scene's)."""
+    from meshes import build_mesh
+
+    return build_mesh(scene, level=level, refine=refine)
+
+
+def solve(scene: Scene, progress=None, level: str | None = None, refine: int | None = None,
+          mesh=None, penalty: float | None = None, keep_states: bool = False) -> Solution:
+    """Solve ``scene`` with the 2D plane-stress reference.
+
+    Parameters
+    ----------
+    scene
+        The problem.
+    progress
+        Called with every converged path state (``step``, ``load_factor``, ``probes``).
+    level, refine
+        Mesh resolution (default: the scene's ``[reference2d]``).
+    mesh
+        A ready ``LayeredMesh`` (or an object with its arrays) instead of building one.
+    penalty
+        Contact penalty (N/mm³) instead of the scene's or the default.
+    keep_states
+        Keep the displacement vector of every converged state in ``extra["states"]``
+        (for :func:`reference2d.write_fields`).
+    """
+    t0 = time.perf_counter()
+    if mesh is None:
+        mesh = build_scene_mesh(scene, level, refine)
+    model = build_model(scene, mesh, penalty=penalty)
+    system = model.system
+    names = [p.name for p in scene.probes]
+    a = scene.analysis
+    rows: list[StepRecord] = []
+    states: list[tuple[int, float, np.ndarray]] = []
+
+    def record(state: PathState) -> None:
+        contact = system.contact_summary()
+        extra = {"max_penetration": contact["max_penetration"],
+                 "max_contact_pressure": contact["max_contact_pressure"],
+                 "cuts": float(state.cuts)}
+        if state.negative_pivots is not None:
+            extra["negative_pivots"] = float(state.negative_pivots)
+        rows.append(StepRecord(state.step, float(state.load_factor),
+                               {n: float(state.probes[n]) for n in names},
+                               int(state.iterations), extra))
+        states.append((state.step, float(state.load_factor), np.array(state.u)))
+        if progress is not None:
+            progress(state)
+
+    limit_points = []
+    if a.kind == "linear":
+        u1 = solve_linear(system, 1.0)
+        lam = _linear_target(scene, system, u1)
+        for step, lf in ((0, 0.0), (1, lam)):
+            u = lf * u1
+            system.commit(u, lf)
+            record(PathState(step, u, lf, 0 if step == 0 else 1,
+                             {n: float(system.probe_vector(n) @ u) for n in names}, None))
+        converged, message = True, f"linear solution scaled to λ = {lam:.6g}"
+    else:
+        options = PathOptions(
+            control=a.control, until_load_factor=a.until_load_factor,
+            until_probe=a.until_probe, until_value=a.until_value, max_steps=a.max_steps,
+            initial_increment=a.initial_increment, min_increment=a.min_increment,
+            max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations)
+        result = follow_path(system, options, names, progress=record)
+        converged, message = result.reached_target, result.message
+        limit_points = result.limit_points
+
+    profiles = _profiles(model, scene, states)
+    penetration = max((r.extra["max_penetration"] for r in rows), default=0.0)
+    extra: dict[str, object] = {
+        "cells": int(len(mesh.cells)),
+        "level": getattr(mesh, "level", level or scene.reference2d.level),
+        "refine": int(getattr(mesh, "refine", refine or 0)),
+        "contact_penalty": model.penalty,
+        "max_penetration": float(penetration),
+        "max_penetration_over_face_thickness": float(
+            penetration / min(scene.top.thickness, scene.bottom.thickness)),
+        "newton_iterations": int(sum(r.iterations for r in rows)),
+        "stress_measure": "second Piola-Kirchhoff, reference frame",
+    }
+    if keep_states:
+        extra["states"] = states
+        extra["model"] = model
+    return Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
+                    limit_points, time.perf_counter() - t0, int(system.size), extra)
+
+
+def _linear_target(scene: Scene, system, u1: np.ndarray) -> float:
+    """Load factor of the linear solution: the until load factor, or the λ hitting until_value."""
+    a = scene.analysis
+    if a.until_load_factor is not None:
+        return float(a.until_load_factor)
+    if a.until_probe is not None:
+        w1 = float(system.probe_vector(a.until_probe) @ u1)
+        if w1 == 0.0:
+            raise ValueError(f"probe {a.until_probe!r} does not move under the load")
+        return float(a.until_value) / w1
+    return 1.0
+
+
+def _profiles(model: Model2D, scene: Scene, states) -> list[Profile]:
+    if not states:
+        return []
+    every = scene.reference2d.profile_every
+    chosen = [s for s in states if every and s[0] % every == 0 and s[0] > 0]
+    if not chosen or chosen[-1][0] != states[-1][0]:
+        chosen.append(states[-1])
+    sampler = ProfileSampler(model)
+    return [Profile(step, sampler.sample(u)) for step, _lf, u in chosen]
