@@ -43,14 +43,18 @@ def render_snapshot(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0,
         core = grid.extract_cells(np.flatnonzero(snapshot.region == 0))
         faces = grid.extract_cells(np.flatnonzero(snapshot.region != 0))
         if faces.n_cells:
-            plotter.add_mesh(faces, color="0.6")
+            plotter.add_mesh(faces, color="gray")
         grid = core
     plotter.add_mesh(grid, scalars=name, cmap="viridis",
                      scalar_bar_args={"title": name, "color": "black"})
-    plotter.add_text(f"{snapshot.model}: step {snapshot.step}, λ = {snapshot.load_factor:.4g}",
-                     font_size=10, color="black")
+    plotter.add_text(f"{snapshot.model}: step {snapshot.step}, "
+                     f"load factor {snapshot.load_factor:.4g}", font_size=10, color="black")
     plotter.view_xz()
-    plotter.camera.zoom(1.0)
+    plotter.enable_parallel_projection()
+    span_x = float(np.ptp(xz[:, 0])) or 1.0
+    span_z = float(np.ptp(xz[:, 1])) or 1.0
+    # half the visible height: fit the whole length (and height) with a 10 % margin
+    plotter.camera.parallel_scale = 0.55 * max(span_x * window[1] / window[0], span_z)
     path.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(path))
     plotter.close()

@@ -138,7 +138,9 @@ def _strip_snapshot(model, nx=31, nz=5):
              for j in range(nz - 1) for i in range(nx - 1)]
     disp = np.column_stack([np.zeros(len(pts)), -10 * np.sin(np.pi * pts[:, 0] / 300)])
     vm = np.abs(np.cos(np.pi * pts[:, 0] / 300))
-    return FieldSnapshot(model, 150, 1.0, pts, disp, np.array(cells), vm)
+    region = np.zeros(len(cells), dtype=int)
+    region[-(nx - 1):] = 1  # the top row of cells is the top face (drawn grey)
+    return FieldSnapshot(model, 150, 1.0, pts, disp, np.array(cells), vm, region)
 
 
 def test_field_snapshot_is_rendered_when_a_model_provides_it(tmp_path, scene, synth):
