@@ -39,7 +39,8 @@ def classical(load, force):
 
 
 def beam_deflection(load, force, elements):
-    loads = (Load("top", L / 2, L, force),) if load == "uniform" else (Load("top", L / 2, 0.0, force),)
+    width = L if load == "uniform" else 0.0
+    loads = (Load("top", L / 2, width, force),)
     scene = sandwich_scene(core_material=IDEAL_CORE, loads=loads, supports=SUPPORTS,
                            elements=elements)
     probes = run(scene).solution.history[-1].probes
