@@ -100,20 +100,35 @@ def cmd_solve(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _compare_and_report(args: argparse.Namespace, scene: Scene, out: Path, reuse: bool) -> int:
+    """Run (or reuse) both models on ``scene``, write the comparison and summarise it."""
+    from comparisons import compare, text_progress
+
+    progress = None if args.quiet else text_progress()
+    cmp = compare(scene, out, reuse=reuse, progress=progress)
+    for model, reason in cmp.missing.items():
+        print(f"{model}: no result ({reason})", file=sys.stderr)
+    curve = cmp.metrics.curve("load_factor")
+    if curve is not None and curve.l2_relative is not None:
+        _say(args, f"load-deflection curve, beam vs 2D: L2 error {100 * curve.l2_relative:.2f} %, "
+             f"max {100 * curve.max_relative:.2f} % over the common range")
+    if cmp.metrics.wall_ratio is not None:
+        _say(args, f"cost: 2D took {cmp.metrics.wall_ratio:.1f}x the beam's wall time, "
+             f"{cmp.metrics.dofs_ratio:.1f}x its DOFs")
+    _say(args, f"pictures, CSVs and metrics.json: {out.resolve()}/")
+    return EXIT_OK if not cmp.missing else EXIT_STOPPED
+
+
 def cmd_compare(args: argparse.Namespace) -> int:
     """Run both models on a scene and overlay them."""
-    from comparisons import compare
-
     (scene,) = _load([args.scene])
     out = Path(args.out) if args.out else Path("results") / scene.name / "compare"
-    cmp = compare(scene, out, reuse=not args.no_reuse, quiet=args.quiet)
-    _say(args, f"comparison written to {out}/ (metrics.json and the PNG figures)")
-    return EXIT_OK if getattr(cmp, "ok", True) else EXIT_STOPPED
+    return _compare_and_report(args, scene, out, reuse=not args.no_reuse)
 
 
 def cmd_gallery(args: argparse.Namespace) -> int:
     """Run every shipped paper-like scene and write the report."""
-    from comparisons import gallery
+    from comparisons import gallery, text_progress
 
     paths = sorted(glob.glob(args.scenes))
     if not paths:
@@ -121,31 +136,16 @@ def cmd_gallery(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     scenes = _load(paths)
     out = Path(args.out) if args.out else Path("results") / "gallery"
-    gallery(scenes, out, quiet=args.quiet)
-    _say(args, f"gallery report: {out}/report.md")
+    gallery(scenes, out, progress=None if args.quiet else text_progress())
+    _say(args, f"gallery report: {(out / 'report.md').resolve()}")
     return EXIT_OK
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    """The README's first command: solve the default scene end to end, say where pictures are."""
+    """The README's first command: both models on the default scene, and where the pictures are."""
     (scene,) = _load([args.scene])
-    try:
-        import comparisons  # noqa: F401
-        from comparisons import compare
-    except ImportError:
-        compare = None
-    if compare is not None:
-        out = Path("results") / scene.name / "compare"
-        compare(scene, out, reuse=False, quiet=args.quiet)
-        _say(args, f"pictures and metrics: {out.resolve()}/")
-        return EXIT_OK
-    code = EXIT_OK
-    for model in MODELS:
-        out = default_out(scene, model)
-        sol = run_model(scene, model, out, quiet=args.quiet)
-        _say(args, f"{model}: results in {out.resolve()}/")
-        code = max(code, EXIT_OK if sol.converged else EXIT_STOPPED)
-    return code
+    out = Path("results") / scene.name / "compare"
+    return _compare_and_report(args, scene, out, reuse=True)
 
 
 def build_parser() -> argparse.ArgumentParser:

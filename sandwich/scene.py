@@ -158,8 +158,8 @@ class BeamModelOptions:
     """Resolution and numerics of the beam element model (table ``[beam_model]``)."""
 
     elements: int = 120
-    gauss_x: int = 4
-    gauss_z: int = 4
+    gauss_x: int | None = None  # None: the rule that integrates the strain energy exactly
+    gauss_z: int | None = None
     contact_penalty: float | None = None
     profile_every: int = 0  # 0: profiles at the last step only
 

@@ -406,8 +406,8 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     d = BeamModelOptions()
     return BeamModelOptions(
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
-        gauss_x=r.integer(t, "gauss_x", key, default=d.gauss_x, lo=2, hi=12) or d.gauss_x,
-        gauss_z=r.integer(t, "gauss_z", key, default=d.gauss_z, lo=2, hi=12) or d.gauss_z,
+        gauss_x=r.integer(t, "gauss_x", key, default=None, lo=2, hi=12),
+        gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
         profile_every=r.integer(t, "profile_every", key, default=0, lo=0) or 0,
     )
