@@ -7,7 +7,8 @@ A solve writes, atomically, into its folder:
 - ``profiles.csv``: ``step, x, w_top, w_bottom, sigma_zz_top, sigma_zz_bottom, tau_core[, more]``
   (interface normal stress at the core's top and bottom boundary, core shear at mid-core, MPa);
 - ``summary.json``: ``model, scene, converged, steps, final_load_factor, limit_points,
-  wall_seconds, dofs`` and more.
+  wall_seconds, dofs`` and more;
+- ``fields.pvd`` + ``fields_NNNNN.vtu`` when the model returns 2D field frames (ParaView).
 """
 
 from __future__ import annotations
@@ -60,6 +61,23 @@ class LimitPoint:
 
 
 @dataclass
+class FieldFrame:
+    """Fields of one converged step on a 2D grid of the beam, for ParaView.
+
+    ``points`` are reference coordinates (x, z) in mm, ``cells`` counter-clockwise quads (m, 4) or
+    triangles (m, 3); ``displacement`` (n, 2) in mm; stresses in MPa as point or cell data.
+    """
+
+    step: int
+    load_factor: float
+    points: np.ndarray
+    cells: np.ndarray
+    displacement: np.ndarray
+    point_data: dict[str, np.ndarray] = field(default_factory=dict)
+    cell_data: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass
 class Solution:
     """What a solve returns: the equilibrium path, profiles and a summary."""
 
@@ -73,6 +91,7 @@ class Solution:
     wall_seconds: float
     dofs: int
     extra: dict[str, object] = field(default_factory=dict)
+    fields: list[FieldFrame] = field(default_factory=list)
 
     @property
     def final_load_factor(self) -> float:
@@ -175,8 +194,29 @@ def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
         "profiles.csv": profiles_csv(solution),
         "summary.json": json.dumps(summary_dict(solution), indent=2, allow_nan=False) + "\n",
     }
+    if solution.fields:
+        files.update(_field_files(solution.fields))
     paths = []
     for name, text in files.items():
         atomic_write_text(out_dir / name, text)
         paths.append(out_dir / name)
     return paths
+
+
+def _field_files(frames: list[FieldFrame]) -> dict[str, str]:
+    """VTU per frame plus a ``fields.pvd`` collection (time = load factor)."""
+    from sandwich.vtu import pvd_text, vtu_text
+
+    out: dict[str, str] = {}
+    entries = []
+    for frame in frames:
+        arrays = [frame.displacement, *frame.point_data.values(), *frame.cell_data.values()]
+        if not all(np.all(np.isfinite(a)) for a in arrays):
+            raise ValueError("refusing to write a non-finite value into a field file")
+        name = f"fields_{frame.step:05d}.vtu"
+        out[name] = vtu_text(frame.points, frame.cells,
+                             {"displacement": frame.displacement, **frame.point_data},
+                             frame.cell_data)
+        entries.append((frame.load_factor, name))
+    out["fields.pvd"] = pvd_text(entries)
+    return out

@@ -45,3 +45,28 @@ def test_nan_is_refused_and_old_files_survive(tmp_path):
         write_solution(_solution(value=math.nan), tmp_path)
     assert (tmp_path / "history.csv").read_text() == before
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_field_frames_are_written_as_vtu_that_vtk_reads(tmp_path):
+    from sandwich.results import FieldFrame
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [2.0, 0.0], [2.0, 1.0]])
+    cells = np.array([[0, 1, 2, 3], [1, 4, 5, 2]])
+    disp = np.column_stack([0.1 * pts[:, 0], -0.2 * pts[:, 0]])
+    sol = _solution()
+    sol.fields = [FieldFrame(1, 10.0, pts, cells, disp, {"sigma_x": pts[:, 0]},
+                             {"von_mises": np.array([1.0, 2.0])})]
+    write_solution(sol, tmp_path)
+    assert (tmp_path / "fields.pvd").exists()
+    vtk = pytest.importorskip("vtk")
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(tmp_path / "fields_00001.vtu"))
+    reader.Update()
+    grid = reader.GetOutput()
+    assert grid.GetNumberOfPoints() == 6 and grid.GetNumberOfCells() == 2
+    d = grid.GetPointData().GetArray("displacement")
+    assert d.GetTuple3(4) == pytest.approx((0.2, -0.4, 0.0))
+    assert grid.GetCellData().GetArray("von_mises").GetValue(1) == 2.0
+    sol.fields[0].displacement[0, 0] = math.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        write_solution(sol, tmp_path / "again")
