@@ -80,19 +80,26 @@ class ContactState:
     tangents: list[np.ndarray]  # per active slave: (8, 8) ∂²Π/∂X²
 
 
-def evaluate(pair: ContactPair, x_cur: np.ndarray, want_tangent: bool = True) -> ContactState:
-    """Gaps, pressures, forces and tangents at current node positions ``x_cur`` (blocks, 2)."""
+def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
+             want_tangent: bool = True) -> ContactState:
+    """Gaps, pressures, forces and tangents at reference positions + displacements (blocks, 2).
+
+    The slave–anchor offset x_s − x_0 is formed as (X_s − X_0) + (u_s − u_0): the positions are
+    ~10² mm while the gap is ~10⁻⁵ mm, and X + u first would lose the gap to round-off (which
+    the stiff penalty turns into a residual floor far above Newton's tolerance).
+    """
     ns = len(pair.slave)
     gaps = np.zeros(ns)
     slips = np.zeros(ns)
     rows, forces, tangents = [], [], []
     for i in range(ns):
         blocks = pair.blocks(i)
-        xs, x0, x1, x2 = x_cur[blocks]
-        g, dg, d2g = gap_with_derivatives(xs, x0, x1, x2)
+        d = (x_ref[blocks[0]] - x_ref[blocks[1]]) + (u[blocks[0]] - u[blocks[1]])
+        x1, x2 = x_ref[blocks[2:]] + u[blocks[2:]]
+        g, dg, d2g = gap_with_derivatives(d, np.zeros(2), x1, x2)
         t = (x2 - x1) / np.linalg.norm(x2 - x1)
         gaps[i] = g
-        slips[i] = (xs - x0) @ t
+        slips[i] = d @ t
         if g < 0.0:
             kw = pair.penalty * pair.width * pair.weight[i]
             rows.append(blocks)

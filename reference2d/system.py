@@ -177,8 +177,8 @@ class Reference2DSystem:
     def _contact_states(self, want_tangent: bool):
         if not self.contacts:
             return []
-        x_cur = self.current_positions()
-        return [(ct.evaluate(p, x_cur, want_tangent), p) for p in self.contacts]
+        u = self.u.x.array.reshape(-1, self.bs)
+        return [(ct.evaluate(p, self.x_ref, u, want_tangent), p) for p in self.contacts]
 
     def _create_matrix(self) -> PETSc.Mat:
         sp = fem.create_sparsity_pattern(self.J_form)
