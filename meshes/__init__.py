@@ -1,0 +1,9 @@
+"""gmsh meshes of the layered beam for the 2D plane-stress reference, debonds drawn as cracks.
+
+gmsh is imported here (in this package) and nowhere else in the project.
+"""
+
+from meshes.build import build_mesh
+from meshes.layered_mesh import LayeredMesh
+
+__all__ = ["LayeredMesh", "build_mesh"]
