@@ -3,3 +3,8 @@
 Public entry points: :func:`solve` (scene -> :class:`sandwich.results.Solution`) and
 :func:`write_fields` (XDMF time series for ParaView).
 """
+
+from reference2d.fields import write_fields
+from reference2d.solve import solve
+
+__all__ = ["solve", "write_fields"]

@@ -1,0 +1,69 @@
+"""Shipped paper scenes on the meshes of :mod:`meshes` at level coarse."""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reference2d import solve, write_fields
+from sandwich.results import PROFILE_COLUMNS, write_solution
+from sandwich.scene import load_scene
+
+pytestmark = pytest.mark.dolfinx
+
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+FIG4 = "paper-fig4-bonded-3pb"
+FIG5 = "paper-fig5-top-debond-40-load-top"
+
+
+def _short(scene, value):
+    return dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
+                                                                   until_value=value))
+
+
+def _check(sol, scene):
+    assert sol.model == "2d" and sol.converged, sol.message
+    assert len(sol.history) >= 3
+    lam = np.array([r.load_factor for r in sol.history])
+    w = np.array([r.probes["w_top_mid"] for r in sol.history])
+    assert np.all(np.diff(lam) > 0) and np.all(np.diff(w) < 0)  # stiffening-free early path
+    assert w[-1] == pytest.approx(scene.analysis.until_value, rel=1e-5)
+    prof = sol.profiles[-1].columns
+    for c in PROFILE_COLUMNS:
+        assert c in prof and np.all(np.isfinite(prof[c]))
+    i = np.argmin(np.abs(prof["x"] - 150.0))
+    assert prof["w_top"][i] == pytest.approx(w[-1], rel=1e-6)
+    assert sol.extra["max_penetration_over_face_thickness"] <= 1e-3
+
+
+@pytest.mark.timeout(300)
+def test_fig4_bonded_coarse_short_path(tmp_path):
+    scene = _short(load_scene(SCENES / f"{FIG4}.toml"), -3.0)
+    sol = solve(scene, level="coarse", keep_states=True)
+    _check(sol, scene)
+    write_solution(sol, tmp_path)
+    xdmf = write_fields(sol, tmp_path / "fields")
+    text = xdmf.read_text()
+    for name in ("displacement", "sigma_x", "sigma_z", "tau", "von_mises"):
+        assert text.count(f'Name="{name}"') == len(sol.history)
+
+
+@pytest.mark.timeout(300)
+def test_fig5_debond_closes_under_the_load_coarse_short_path():
+    scene = _short(load_scene(SCENES / f"{FIG5}.toml"), -3.0)
+    sol = solve(scene, level="coarse")
+    _check(sol, scene)
+    prof = sol.profiles[-1].columns
+    under = (prof["x"] > 145) & (prof["x"] < 155)
+    assert np.all(prof["p_contact_top"][under] > 0)  # the load presses the lip shut
+    outside = (prof["x"] < 130) | (prof["x"] > 170)
+    assert np.all(prof["p_contact_top"][outside] == 0)
+
+
+@pytest.mark.heavy
+@pytest.mark.parametrize("name", [FIG4, FIG5])
+def test_full_path_coarse(name):
+    scene = load_scene(SCENES / f"{name}.toml")
+    sol = solve(scene, level="coarse")
+    _check(sol, scene)
