@@ -5,5 +5,7 @@ gmsh is imported here (in this package) and nowhere else in the project.
 
 from meshes.build import build_mesh
 from meshes.layered_mesh import LayeredMesh
+from meshes.quality import MeshQuality, quality_report
+from meshes.write import write_mesh
 
-__all__ = ["LayeredMesh", "build_mesh"]
+__all__ = ["LayeredMesh", "MeshQuality", "build_mesh", "quality_report", "write_mesh"]

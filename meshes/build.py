@@ -23,7 +23,7 @@ def segments_for(layout: Layout, sizing: Sizing) -> list[Segment]:
 
 
 def z_levels(scene: Scene) -> list[float]:
-    """z of the bottom surface, bottom interface, core mid-plane, top interface, top surface."""
+    """Z of the bottom surface, bottom interface, core mid-plane, top interface, top surface."""
     hc2 = 0.5 * scene.core.thickness
     return [-hc2 - scene.bottom.thickness, -hc2, 0.0, hc2, hc2 + scene.top.thickness]
 

@@ -110,7 +110,8 @@ def _entries(scene: Scene, x_end: float, half: bool) -> list[tuple[float, str, s
     return [e for e in out if -GEOM_TOL <= e[0] <= x_end + GEOM_TOL]
 
 
-def _snap(entries: list[tuple[float, str, str]], tol: float) -> dict[str, float]:
+def _snap(entries: list[tuple[float, str, str]], tol: float,
+          interface: dict[str, str]) -> dict[str, float]:
     """Merge stations closer than ``tol``; return label -> new x, warning about every move."""
     entries = sorted(entries)
     clusters: list[list[tuple[float, str, str]]] = [[entries[0]]]
@@ -127,6 +128,10 @@ def _snap(entries: list[tuple[float, str, str]], tol: float) -> dict[str, float]
         if len(set(owners)) < len(owners):
             raise ValueError(f"{owners[0]} is shorter than {tol:g} mm, the smallest debond this "
                              "mesh level can resolve; remove it (bonded) or use a finer level")
+        sides = [interface[o] for o in owners]
+        if len(set(sides)) < len(sides):
+            raise ValueError(f"{' and '.join(owners)} on one interface are less than {tol:g} mm "
+                             "apart (one element): merge them into one debond or use a finer level")
         for e in cl:
             if abs(e[0] - anchor[0]) > GEOM_TOL:
                 warnings.warn(f"mesh: {e[2]} moved from {e[0]:g} to {anchor[0]:g} mm onto "
@@ -156,7 +161,8 @@ def make_layout(scene: Scene, snap_tolerance: float, half: bool = False) -> Layo
             raise ValueError(f"scene {scene.name!r} cannot be meshed as a half model: {why}")
     x_end = 0.5 * L if half else L
     entries = _entries(scene, x_end, half)
-    where = _snap(entries, snap_tolerance)
+    where = _snap(entries, snap_tolerance,
+                  {f"debonds[{i}]": d.interface for i, d in enumerate(scene.debonds)})
     cracks = []
     for i, d in enumerate(scene.debonds):
         if d.length <= 0:

@@ -18,7 +18,7 @@ def _lagrange(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def shape_gradients(xi: np.ndarray) -> np.ndarray:
-    """d N_a / d(xi, eta) at reference points ``xi`` (q, 2): array (q, 9, 2)."""
+    """D N_a / d(xi, eta) at reference points ``xi`` (q, 2): array (q, 9, 2)."""
     nx, dx = _lagrange(xi[:, 0])
     ny, dy = _lagrange(xi[:, 1])
     ix = (NODES[:, 0] + 1).astype(int)
@@ -37,7 +37,7 @@ def gauss_points() -> tuple[np.ndarray, np.ndarray]:
 
 
 def jacobian_determinants(points: np.ndarray, cells: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """det J of every cell at the reference points ``xi``: array (n_cells, q)."""
+    """Determinant of the Jacobian of every cell at the reference points ``xi``: array (n_cells, q)."""
     g = shape_gradients(xi)  # (q, 9, 2)
     J = np.einsum("cai,qaj->cqij", points[cells], g)  # (c, q, 2 coords, 2 ref)
     return J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
