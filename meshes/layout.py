@@ -95,7 +95,8 @@ def _entries(scene: Scene, x_end: float, half: bool) -> list[tuple[float, str, s
     out.append((x_end, "symmetry" if half else "end", "mid-span" if half else f"beam end x={L:g}"))
     for i, d in enumerate(scene.debonds):
         if d.length > 0:
-            out += [(d.start, "debond", f"debonds[{i}].start"), (d.end, "debond", f"debonds[{i}].end")]
+            out += [(d.start, "debond", f"debonds[{i}].start"),
+                    (d.end, "debond", f"debonds[{i}].end")]
     for i, s in enumerate(scene.supports):
         out.append((s.x, "support", f"supports[{i}].x"))
     for i, ld in enumerate(scene.loads):

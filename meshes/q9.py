@@ -37,7 +37,7 @@ def gauss_points() -> tuple[np.ndarray, np.ndarray]:
 
 
 def jacobian_determinants(points: np.ndarray, cells: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """Determinant of the Jacobian of every cell at the reference points ``xi``: array (n_cells, q)."""
+    """Jacobian determinant of every cell at reference points ``xi``: array (n_cells, q)."""
     g = shape_gradients(xi)  # (q, 9, 2)
     J = np.einsum("cai,qaj->cqij", points[cells], g)  # (c, q, 2 coords, 2 ref)
     return J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
