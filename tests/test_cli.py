@@ -1,0 +1,65 @@
+"""The `sandwich` command as a user runs it: files written, exit codes, no traceback."""
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from sandwich.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _small_scene(tmp_path, extra_analysis=""):
+    text = (ROOT / "scenes" / "default.toml").read_text()
+    text = text.replace("value = -8", "value = -1")
+    text = text.replace("max_steps = 400", "max_steps = 400" + extra_analysis)
+    text += "\n[beam_model]\nelements = 40\n"
+    path = tmp_path / "small.toml"
+    path.write_text(text)
+    return path
+
+
+def test_solve_beam_writes_the_contract_files(tmp_path, capsys):
+    scene = _small_scene(tmp_path)
+    out = tmp_path / "out"
+    assert main(["solve", str(scene), "--model", "beam", "--out", str(out), "--quiet"]) == 0
+    with open(out / "history.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert float(rows[-1]["w_top_mid"]) == pytest.approx(-1.0, rel=1e-4)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["model"] == "beam" and summary["converged"] is True
+    assert summary["steps"] == len(rows)
+    assert (out / "profiles.csv").stat().st_size > 0
+    assert capsys.readouterr().out == ""  # --quiet
+
+
+def test_stopped_run_keeps_converged_steps_and_exits_1(tmp_path, capsys):
+    scene = _small_scene(tmp_path)
+    scene.write_text(scene.read_text().replace("max_steps = 400", "max_steps = 2"))
+    out = tmp_path / "out"
+    code = main(["solve", str(scene), "--model", "beam", "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "stopped before the target" in err and "Traceback" not in err
+    with open(out / "history.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) >= 2
+    assert json.loads((out / "summary.json").read_text())["converged"] is False
+
+
+def test_mesh_command_writes_msh_and_xdmf(tmp_path, capsys):
+    out = tmp_path / "mesh"
+    assert main(["mesh", str(ROOT / "scenes" / "default.toml"), "--level", "coarse",
+                 "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "cells" in printed and "lip pairs" in printed
+    assert (out / "default.msh").exists() and (out / "default.xdmf").exists()
+
+
+def test_bad_model_name_is_a_usage_error_not_a_traceback(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["solve", str(ROOT / "scenes" / "default.toml"), "--model", "fem3d"])
+    assert info.value.code == 2
+    assert "invalid choice" in capsys.readouterr().err
