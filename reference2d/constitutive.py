@@ -72,7 +72,7 @@ def cell_centroids(mesh, n_cells: int) -> np.ndarray:
 
 
 def internal_work(u, v, stiffness: PlaneStressStiffness, width: float):
-    """b ∫ (F S) : ∇v dx — the internal virtual work (first Piola–Kirchhoff P = F S)."""
+    """B ∫ (F S) : ∇v dx — the internal virtual work (first Piola–Kirchhoff P = F S)."""
     F = deformation_gradient(u)
     S = stiffness.pk2(green_lagrange(u))
     return width * ufl.inner(F * S, ufl.grad(v)) * ufl.dx

@@ -19,10 +19,9 @@ def write_fields(solution, path: str | Path, every: int = 1) -> Path:
     and the plane-stress ``von_mises`` (MPa). The file is written collectively over the mesh's
     communicator (one file, as dolfinx does).
     """
-    if "model" not in solution.extra or "states" not in solution.extra:
-        raise ValueError("write_fields needs solve(..., keep_states=True)")
-    model = solution.extra["model"]
-    states = solution.extra["states"]
+    if not hasattr(solution, "reference2d_states"):
+        raise ValueError("write_fields needs the solution of solve(..., keep_states=True)")
+    model, states = solution.reference2d_states
     path = Path(path).with_suffix(".xdmf")
     if model.disc.mesh.comm.rank == 0:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -19,7 +19,7 @@ def edge_facets(msh, on_edge) -> np.ndarray:
 
 def edge_load_vector(V, facets: np.ndarray, traction: tuple[float, float], width: float,
                      n_local: int) -> np.ndarray:
-    """b ∫_edge t · v ds over ``facets`` as a local array (owned DOFs, ghosts summed in)."""
+    """B ∫_edge t · v ds over ``facets`` as a local array (owned DOFs, ghosts summed in)."""
     msh = V.mesh
     facets = np.sort(np.asarray(facets, dtype=np.int32))
     tags = mesh.meshtags(msh, 1, facets, np.full(len(facets), EDGE_TAG, dtype=np.int32))

@@ -47,13 +47,13 @@ def face_band(scene: Scene, face: str) -> LayerBand:
 
 
 def outer_z(scene: Scene, face: str) -> float:
-    """z of a face's outer edge (mm)."""
+    """Z of a face's outer edge (mm)."""
     band = face_band(scene, face)
     return band.z_hi if face == "top" else band.z_lo
 
 
 def interface_z(scene: Scene, interface: str) -> float:
-    """z of the face/core interface "top" or "bottom" (mm)."""
+    """Z of the face/core interface "top" or "bottom" (mm)."""
     return 0.5 * scene.core.thickness * (1.0 if interface == "top" else -1.0)
 
 
@@ -147,7 +147,7 @@ def load_vector(scene: Scene, V, X: np.ndarray, n_local: int) -> np.ndarray:
 
 
 def probe_vector(V, x: float, band: LayerBand, n_local: int) -> np.ndarray:
-    """c with c · u = w(x, z_mid) of the face ``band`` (Q2 interpolation in its cell)."""
+    """C with c · u = w(x, z_mid) of the face ``band`` (Q2 interpolation in its cell)."""
     msh = V.mesh
     z_mid = 0.5 * (band.z_lo + band.z_hi)
     point = np.array([[x, z_mid, 0.0]])
@@ -165,7 +165,8 @@ def probe_vector(V, x: float, band: LayerBand, n_local: int) -> np.ndarray:
     return c
 
 
-def contact_pairs(scene: Scene, mesh, disc: Discretisation, penalty: float) -> tuple[list[ct.ContactPair], list[str]]:
+def contact_pairs(scene: Scene, mesh, disc: Discretisation,
+                  penalty: float) -> tuple[list[ct.ContactPair], list[str]]:
     """Node-to-segment contact data of every debond that has lip nodes."""
     pairs, ifaces = [], []
     lip_pairs = getattr(mesh, "lip_pairs", {}) or {}

@@ -1,5 +1,7 @@
-"""Newton's method at a fixed load factor on a :class:`DiscreteSystem` (used for linear solves,
-manufactured solutions and tests; path following lives in :mod:`sandwich.solver.path`)."""
+"""Newton's method at a fixed load factor on a :class:`DiscreteSystem`.
+
+Used for manufactured solutions and tests; path following lives in :mod:`sandwich.solver.path`.
+"""
 
 from __future__ import annotations
 

@@ -39,8 +39,8 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     penalty
         Contact penalty (N/mm³) instead of the scene's or the default.
     keep_states
-        Keep the displacement vector of every converged state in ``extra["states"]``
-        (for :func:`reference2d.write_fields`).
+        Keep the model and the displacement vector of every converged state on the returned
+        solution (attribute ``reference2d_states``) for :func:`reference2d.write_fields`.
     """
     t0 = time.perf_counter()
     if mesh is None:
@@ -99,11 +99,11 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "newton_iterations": int(sum(r.iterations for r in rows)),
         "stress_measure": "second Piola-Kirchhoff, reference frame",
     }
-    if keep_states:
-        extra["states"] = states
-        extra["model"] = model
-    return Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
-                    limit_points, time.perf_counter() - t0, int(system.size), extra)
+    solution = Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
+                        limit_points, time.perf_counter() - t0, int(system.size), extra)
+    if keep_states:  # not part of the result contract: kept off ``extra`` (summary.json)
+        solution.reference2d_states = (model, states)
+    return solution
 
 
 def _linear_target(scene: Scene, system, u1: np.ndarray) -> float:

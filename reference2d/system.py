@@ -114,7 +114,7 @@ class Reference2DSystem:
         self._set_u(u)
         with self.b.localForm() as b_local:
             b_local.set(0.0)
-            for state, pair in self._contact_states(want_tangent=False):
+            for state, _pair in self._contact_states(want_tangent=False):
                 for rows, f in zip(state.rows, state.forces, strict=True):
                     dofs = (self.bs * rows[:, None] + np.arange(self.bs)).ravel()
                     np.add.at(b_local.array, dofs, f)
@@ -157,7 +157,7 @@ class Reference2DSystem:
         return MumpsFactorization(K, self.comm)
 
     def probe_vector(self, name: str) -> np.ndarray:
-        """c with probe value c · u."""
+        """C with probe value c · u."""
         return self.probes[name][: self.n_owned]
 
     def commit(self, u: np.ndarray, load_factor: float) -> None:
@@ -165,13 +165,13 @@ class Reference2DSystem:
         self._set_u(u)
         self.last_contact = [s for s, _ in self._contact_states(want_tangent=False)]
 
-    # -- helpers ------------------------------------------------------------------------------------
+    # -- helpers ---------------------------------------------------------------------------------
     def _set_u(self, u: np.ndarray) -> None:
         self.u.x.array[: self.n_owned] = u
         self.u.x.scatter_forward()
 
     def current_positions(self) -> np.ndarray:
-        """x = X + u for every local DOF block, (blocks, 2)."""
+        """X = X + u for every local DOF block, (blocks, 2)."""
         return self.x_ref + self.u.x.array.reshape(-1, self.bs)
 
     def _contact_states(self, want_tangent: bool):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from r2d_structured import layered_mesh
 
 from reference2d.constitutive import LayerBand, PlaneStressStiffness, internal_work
 from reference2d.loads import edge_facets, edge_load_vector
@@ -10,7 +11,6 @@ from reference2d.mesh import build_discretisation
 from reference2d.model import probe_vector
 from reference2d.system import Reference2DSystem
 from sandwich.scene import Material
-from r2d_structured import layered_mesh
 
 TOL = 1e-7
 

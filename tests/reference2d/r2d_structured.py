@@ -48,9 +48,8 @@ def layered_mesh(length, layers, nx, debonds=(), x0=0.0):
     for ex in range(nx):
         for ez in range(len(z_layer)):
             i, j = 2 * ex, 2 * ez
-            node = lambda a, b: idx[i + a, j + b]  # noqa: E731
-            c = [node(0, 0), node(2, 0), node(2, 2), node(0, 2), node(1, 0), node(2, 1),
-                 node(1, 2), node(0, 1), node(1, 1)]
+            c = [idx[i + a, j + b] for a, b in ((0, 0), (2, 0), (2, 2), (0, 2), (1, 0), (2, 1),
+                                                (1, 2), (0, 1), (1, 1))]
             lay = z_layer[ez]
             # face cells adjacent to a debonded interface use the duplicated (face-lip) nodes
             for (iz, iface), fmap in dup.items():

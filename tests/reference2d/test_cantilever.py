@@ -1,10 +1,9 @@
 """Homogeneous cantilevers: linear limit vs beam theory, large deflection vs the elastica."""
 
-import numpy as np
 import pytest
-
 from r2d_elastica import elastica_tip
 from r2d_helpers import cantilever
+
 from sandwich.solver.path import PathOptions, follow_path, solve_linear
 
 pytestmark = pytest.mark.dolfinx

@@ -3,8 +3,8 @@ Newton converges quadratically with contact active."""
 
 import numpy as np
 import pytest
-
 from r2d_helpers import pressed_strip
+
 from reference2d.newton import newton
 
 pytestmark = pytest.mark.dolfinx

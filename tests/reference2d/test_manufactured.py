@@ -6,11 +6,16 @@ import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from petsc4py import PETSc
-
 from r2d_helpers import isotropic
 from r2d_structured import layered_mesh
-from reference2d.constitutive import (LayerBand, PlaneStressStiffness, deformation_gradient,
-                                      green_lagrange, internal_work)
+
+from reference2d.constitutive import (
+    LayerBand,
+    PlaneStressStiffness,
+    deformation_gradient,
+    green_lagrange,
+    internal_work,
+)
 from reference2d.mesh import build_discretisation
 from reference2d.newton import newton
 from reference2d.system import Reference2DSystem

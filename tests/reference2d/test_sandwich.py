@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from r2d_structured import layered_mesh
+
 from reference2d import solve
 from sandwich.scene import load_scene
 

@@ -46,7 +46,7 @@ def test_fig4_bonded_coarse_short_path(tmp_path):
     xdmf = write_fields(sol, tmp_path / "fields")
     text = xdmf.read_text()
     for name in ("displacement", "sigma_x", "sigma_z", "tau", "von_mises"):
-        assert text.count(f'Name="{name}"') == len(sol.history)
+        assert text.count(f'<Attribute Name="{name}"') == len(sol.history)
 
 
 @pytest.mark.timeout(300)

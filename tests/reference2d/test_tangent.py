@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 from petsc4py import PETSc
+from r2d_structured import layered_mesh
 
 from reference2d.model import build_model
 from sandwich.scene import load_scene
-from r2d_structured import layered_mesh
 
 pytestmark = pytest.mark.dolfinx
 
