@@ -72,6 +72,10 @@ class PathOptions:
         Jump guards (see the module docstring).
     target_tol
         Relative tolerance on hitting ``until_value`` / ``until_load_factor`` by step cutting.
+    target_accept
+        If the crossed target cannot be hit within ``target_tol`` (corrector failures on the
+        shortened steps), the closest state is still accepted as reaching the target when it
+        misses by at most this (relative); the message says by how much.
     """
 
     control: str = "load"
@@ -90,6 +94,7 @@ class PathOptions:
     max_correction_ratio: float = 1.0
     max_predictor_growth: float = 4.0
     target_tol: float = 1e-6
+    target_accept: float = 1e-3
 
     def __post_init__(self) -> None:
         if self.control not in CONTROLS:
@@ -269,6 +274,9 @@ class _Follower:
                 return self.finish(True, done)
             if crossed:
                 s = self.states[-1]
+                near = self._near_target(crossed, s)
+                if near:
+                    return self.finish(True, near)
                 return self.finish(False, (
                     f"step {s.step}: the target on {crossed} was crossed but could not be hit "
                     f"within target_tol = {opt.target_tol:g} (stopped at λ = "
@@ -436,7 +444,12 @@ class _Follower:
             if not (min(a, b) < x < max(a, b)):
                 x = 0.5 * (a + b)
             cand, _ = self._attempt(x, last, t)
-            if cand is None:  # a shorter step should converge; give up on hitting if not
+            if cand is None and not math.isclose(x, 0.5 * (a + b)):
+                # a very short step can trip the jump guard (corrector longer than predictor):
+                # fall back to the middle of the bracket once before giving up
+                x = 0.5 * (a + b)
+                cand, _ = self._attempt(x, last, t)
+            if cand is None:
                 break
             fx = self._value(name, cand.u, cand.load_factor) - target
             if abs(fx) < abs(best_g):
@@ -452,6 +465,21 @@ class _Follower:
                     fb *= 0.5
                 side = 1
         return best, best_h, name
+
+    def _near_target(self, name: str, s: PathState) -> str:
+        """Message if a crossed target was missed by at most ``target_accept`` (relative)."""
+        opt = self.opt
+        if name == opt.until_probe:
+            v, target = s.probes[name], opt.until_value
+        elif opt.until_load_factor is not None:
+            v, target = s.load_factor, opt.until_load_factor
+        else:
+            return ""
+        if abs(v - target) <= opt.target_accept * abs(target):
+            return (f"reached {name} = {v:.6g} (target {target:.6g}, hit within "
+                    f"{abs(v - target) / abs(target):.1e} relative, not within target_tol = "
+                    f"{opt.target_tol:g}) at step {s.step}, λ = {s.load_factor:.6g}")
+        return ""
 
     def _target_reached(self) -> str:
         """Message if the last state satisfies a stopping target, else ``""``."""
