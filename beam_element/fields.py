@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from beam_element.contact import penalty_response
+from beam_element.contact import NORMAL_SIGN, penalty_response, pressure_law
 from beam_element.kinematics import gradients, green_lagrange, linear_strains
 from beam_element.model import BeamModel
 
@@ -103,8 +103,14 @@ def profile_columns(
         g_nodes = np.zeros(model.mesh.n_nodes)
         for pairs in model.pairs:
             if pairs.interface == interface:
-                _, _, p, k = penalty_response(pairs, u_full, model.penalty)
-                p_nodes[pairs.nodes], g_nodes[pairs.nodes] = p, k.gap
+                if nonlinear:
+                    _, _, p, k = penalty_response(pairs, u_full, model.penalty, model.smoothing)
+                    gap = k.gap
+                else:  # the linear analysis' law: plain penalty on the linearised gap
+                    v = u_full[pairs.dofs]
+                    gap = NORMAL_SIGN[pairs.interface] * (v[:, 1] - v[:, 3])
+                    p = pressure_law(gap, model.penalty)[0]
+                p_nodes[pairs.nodes], g_nodes[pairs.nodes] = p, gap
         out[f"p_contact_{interface}"] = np.interp(x, model.mesh.x, p_nodes)
         out[f"gap_{interface}"] = np.interp(x, model.mesh.x, g_nodes)
     return out

@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from beam_element.assembly import ReducedPattern, reduced_pattern, scatter_vector
 from beam_element.constitutive import core_stiffness, face_stiffness
 from beam_element.constraints import DofMap, NodeSupport, build_dof_map
-from beam_element.contact import ContactPairs, contact_pairs, penalty_response
+from beam_element.contact import ContactPairs, contact_pairs, in_contact, penalty_response
 from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
 from beam_element.element import GeometricProducts, geometric_products, layer_response
 from beam_element.layer_operators import LayerOperators, build_layer_operators
@@ -28,6 +28,7 @@ from beam_element.quadrature import EXACT_ORDER
 CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
 PENALTY_FACTOR = 1e4  # default contact penalty ε = PENALTY_FACTOR · Q_z / h_c  (N/mm³)
 PENETRATION_BOUND = 1e-3  # allowed penetration / face thickness
+SMOOTHING_FRACTION = 0.002  # default contact regularisation width s = SMOOTHING_FRACTION × bound
 
 
 @dataclass
@@ -55,6 +56,7 @@ class BeamModel:
     f_ref_full: np.ndarray
     probe_rows: dict[str, np.ndarray]
     face_thickness: dict[str, float]
+    smoothing: float = 0.0  # contact regularisation width s (mm), see beam_element.contact
     pattern: ReducedPattern = field(init=False)
     committed: dict[str, ContactSummary] = field(default_factory=dict)
     max_penetration_seen: float = 0.0
@@ -149,7 +151,7 @@ class BeamModel:
             forces.append(f)
             blocks.append(K)
         for pairs in self.pairs:
-            fc, Kc, _, _ = penalty_response(pairs, u_full, self.penalty)
+            fc, Kc, _, _ = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(fc)
             blocks.append(Kc)
         f_full = scatter_vector(u_full.size, self.block_dofs, forces)
@@ -160,8 +162,8 @@ class BeamModel:
         u_full = self.expand(u)
         out = {}
         for pairs in self.pairs:
-            _, _, p, k = penalty_response(pairs, u_full, self.penalty)
-            active = p > 0
+            _, _, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
+            active = in_contact(k.gap, self.smoothing)
             out[pairs.interface] = ContactSummary(
                 max_penetration=float(np.max(-k.gap, initial=0.0)),
                 max_pressure=float(np.max(p, initial=0.0)),
@@ -209,6 +211,7 @@ def build_model(
     elements: int | None = None,
     gauss: dict[str, tuple[int, int]] | None = None,
     contact_penalty: float | None = None,
+    contact_smoothing: float | None = None,
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -224,6 +227,10 @@ def build_model(
     contact_penalty
         Contact penalty ε (N/mm³); default ``scene.beam_model.contact_penalty`` or
         ``PENALTY_FACTOR · Q_z / h_c``.
+    contact_smoothing
+        Width s (mm) over which the penalty pressure is regularised
+        (:func:`~beam_element.contact.pressure_law`); default ``SMOOTHING_FRACTION`` × the
+        penetration bound. 0 gives the plain (kinked) penalty.
     """
     options = getattr(scene, "beam_model", None)
     if elements is None:
@@ -264,8 +271,11 @@ def build_model(
         contact_penalty = getattr(options, "contact_penalty", None)
     if contact_penalty is None:
         contact_penalty = PENALTY_FACTOR * stiffness["core"][1, 1] / hc
+    if contact_smoothing is None:
+        contact_smoothing = SMOOTHING_FRACTION * PENETRATION_BOUND * min(ht, hb)
     return BeamModel(
         name=scene.name, mesh=mesh, width=float(scene.width), layers=layers, products=products,
         dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,
         probe_rows=probes, face_thickness={"top": ht, "bottom": hb},
+        smoothing=float(contact_smoothing),
     )

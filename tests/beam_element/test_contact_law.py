@@ -1,0 +1,71 @@
+"""The regularised (shifted softplus) contact law of beam_element.contact.
+
+References: the closed-form energy (dilogarithm) differentiated by central finite differences; the
+law's own definition for the limits (p = 0 for g ≥ 0, p → ε(−g − c s) deep in contact).
+"""
+
+import numpy as np
+
+from beam_element.contact import (
+    SHIFT,
+    contact_energy,
+    contact_pairs,
+    pair_kinematics,
+    penalty_response,
+    pressure_law,
+)
+
+EPS = 2.24e4  # N/mm³, the default penalty for the paper's Rohacell core
+S = 1e-6  # mm, the default regularisation width for 0.5 mm faces
+
+
+def test_pressure_is_the_energy_derivative_and_stiffness_its_derivative():
+    g = -S * np.array([0.5, 5.0, 20.0, 24.0, 25.0, 26.0, 30.0, 60.0, 400.0])
+    p, dp = pressure_law(g, EPS, S)
+    h = 1e-4 * S
+    fd_p = -(contact_energy(g + h, EPS, S) - contact_energy(g - h, EPS, S)) / (2 * h)
+    fd_dp = (pressure_law(g + h, EPS, S)[0] - pressure_law(g - h, EPS, S)[0]) / (2 * h)
+    assert np.allclose(p, fd_p, rtol=1e-6, atol=1e-12 * EPS * S)
+    assert np.allclose(dp, fd_dp, rtol=1e-6)
+
+
+def test_no_force_when_open_and_plain_penalty_deep_in_contact():
+    p, dp = pressure_law(np.array([0.0, 1e-9, 1.0]), EPS, S)
+    assert np.all(p == 0) and np.all(dp == 0)
+    g = np.array([-1e-3, -1e-2])
+    p, dp = pressure_law(g, EPS, S)
+    assert np.allclose(p, EPS * (-g - SHIFT * S), rtol=1e-9)
+    assert np.allclose(dp, -EPS, rtol=1e-9)
+    # the stiffness jump left at g = 0 is ε e^(-c): negligible against any structure
+    assert -pressure_law(np.array([-1e-15 * S]), EPS, S)[1][0] < 1e-10 * EPS
+
+
+def test_penetration_is_at_most_offset_plus_plain_penalty():
+    g = -np.logspace(-9, -2, 50)
+    p, _ = pressure_law(g, EPS, S)
+    assert np.all(-g <= SHIFT * S + p / EPS + 1e-15)
+
+
+def test_contact_tangent_matches_finite_differences_in_the_smooth_band():
+    rng = np.random.default_rng(7)
+    x = np.linspace(0.0, 10.0, 6)
+    pairs = contact_pairs("top", np.arange(1, 5), x, 60.0)
+    u = rng.normal(size=20 * 6) * 0.05
+    # place every pair's gap inside the band where the stiffness changes most (g ≈ −c s)
+    w_face = pairs.dofs[:, 1]
+    for _ in range(5):  # Newton on the face w to hit the target gaps
+        k = pair_kinematics(pairs, u)
+        target = -SHIFT * S * np.array([0.6, 0.9, 1.0, 1.2])
+        u[w_face] -= (k.gap - target) / k.grad[:, 1]
+    k = pair_kinematics(pairs, u)
+    assert np.all(k.gap < 0) and np.all(k.gap > -2 * SHIFT * S)
+    f, K, _, _ = penalty_response(pairs, u, EPS, S)
+    step = 1e-4 * S
+    for m in range(pairs.size):
+        for j in range(6):
+            du = np.zeros_like(u)
+            du[pairs.dofs[m, j]] = step
+            fp = penalty_response(pairs, u + du, EPS, S)[0][m]
+            fm = penalty_response(pairs, u - du, EPS, S)[0][m]
+            fd = (fp - fm) / (2 * step)
+            assert np.allclose(K[m][:, j], fd, rtol=1e-5, atol=1e-6 * np.abs(K[m]).max())
