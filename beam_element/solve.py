@@ -15,10 +15,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from beam_element.contact import NORMAL_SIGN
-from beam_element.fields import profile_columns
+from beam_element.fields import profile_columns, section_fields
 from beam_element.model import BeamModel, build_model
 from beam_element.quadrature import EXACT_ORDER
-from sandwich.results import LimitPoint, Profile, Solution, StepRecord
+from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
 
 MAX_ACTIVE_SET_PASSES = 50
 MIN_INCREMENT_PER_SMOOTHING = 0.01  # default path increment floor / contact smoothing width s
@@ -188,6 +188,22 @@ def solve(scene: object, progress: Callable[[object], None] | None = None) -> So
     return run(scene, progress).solution
 
 
+def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> FieldFrame:
+    """Faces and core of ``state`` on one quad grid (``section_fields``) as a ParaView frame.
+
+    Point data: σ_x, σ_z, τ, von Mises (MPa, 2nd Piola-Kirchhoff); cell data: ``region``
+    (0 core, 1 top face, 2 bottom face). Points are reference (x, z), displacement (u, w) in mm.
+    """
+    f = section_fields(model, state.u, nonlinear=nonlinear)
+    return FieldFrame(
+        step=state.step, load_factor=state.load_factor, points=f.points, cells=f.cells,
+        displacement=f.displacement,
+        point_data={"sigma_x": f.sigma_x, "sigma_z": f.sigma_z, "tau": f.tau,
+                    "von_mises": f.von_mises},
+        cell_data={"region": f.region.astype(float)},
+    )
+
+
 def _solution(
     scene: object, model: BeamModel, states: list[ConvergedState], nonlinear: bool,
     converged: bool, message: str, limit_points: list[LimitPoint],
@@ -208,6 +224,7 @@ def _solution(
     chosen.append(states[-1])
     profiles = [Profile(step=s.step, columns=profile_columns(model, s.u, nonlinear))
                 for s in chosen]
+    fields = [_field_frame(model, s, nonlinear) for s in chosen]
     bound = model.penetration_bound()
     if max_pen > bound:
         message += (f"; WARNING: contact penetration {max_pen:.3g} mm exceeds "
@@ -215,11 +232,13 @@ def _solution(
     return Solution(
         model="beam", scene=scene.name, history=history, profiles=profiles, converged=converged,
         message=message, limit_points=limit_points, wall_seconds=0.0, dofs=model.size,
+        fields=fields,
         extra={
             "elements": model.mesh.n_elements,
             "nodes": model.mesh.n_nodes,
             "analysis": "nonlinear" if nonlinear else "linear",
-            "gauss": {k: list(v) for k, v in _gauss_orders(scene).items()},
+            **{f"gauss_{layer}_{axis}": n for layer, orders in _gauss_orders(scene).items()
+               for axis, n in zip(("x", "z"), orders, strict=True)},
             "contact_pairs": int(sum(p.size for p in model.pairs)),
             "contact_penalty": model.penalty,
             "max_penetration": max_pen,
