@@ -3,7 +3,8 @@
 Slave nodes are the face-lip nodes; each is paired with the coincident core-lip node (its anchor,
 x_0). The master surface near the anchor is the tangent line of the deformed core lip there, with
 its direction taken from the chord of the anchor's two neighbours on the core lip, x_1 → x_2
-(the crack-tip nodes close the chain at both ends). The gap is the signed distance of the slave
+(the crack-tip nodes close the chain; at an open mouth, where the debond reaches the beam
+end, the last chord is one-sided: the anchor and its single neighbour). The gap is the signed distance of the slave
 from that line along its normal n = J (x_2 − x_1)/|x_2 − x_1|, J a +90° rotation, the chain being
 ordered so that n points out of the core:
 
@@ -110,20 +111,27 @@ def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
     return ContactState(gaps, slips, pressure, rows, forces, tangents)
 
 
-def slave_weights(x_ref: np.ndarray, x_left_tip: float, x_right_tip: float) -> np.ndarray:
+def slave_weights(x_ref: np.ndarray, x_left_tip: float | None,
+                  x_right_tip: float | None) -> np.ndarray:
     """Tributary lengths of face-lip nodes on quadratic facets (Simpson weights 1/6, 2/3, 1/6).
 
-    The nodes, sorted by x, alternate mid-side / corner between the two tips (which are corners
-    and carry no contact: they are bonded).
+    The nodes, sorted by x, alternate mid-side / corner along the lip. A crack tip (a corner
+    shared by both lips, bonded, no contact) closes the chain at either end; ``None`` means the
+    debond reaches the beam end there (open mouth): the outermost lip node is then itself a
+    corner, a slave with the single-facet weight h/6.
     """
-    xs = np.concatenate([[x_left_tip], np.sort(x_ref), [x_right_tip]])
-    if len(xs) % 2 == 0:
-        raise ValueError("face-lip nodes must alternate mid-side / corner between the tips")
+    inner = np.sort(np.asarray(x_ref, dtype=float))
+    xs = np.concatenate([[] if x_left_tip is None else [x_left_tip], inner,
+                         [] if x_right_tip is None else [x_right_tip]])
+    if len(xs) % 2 == 0 or len(xs) < 3:
+        raise ValueError("face-lip nodes must alternate corner / mid-side / corner along the lip")
     w = np.zeros(len(xs))
     for e in range(0, len(xs) - 2, 2):
         h = xs[e + 2] - xs[e]
         w[e] += h / 6.0
         w[e + 1] += 2.0 * h / 3.0
         w[e + 2] += h / 6.0
+    lo = 0 if x_left_tip is None else 1
+    w_sorted = w[lo: lo + len(inner)]
     order = np.argsort(np.argsort(x_ref))
-    return w[1:-1][order]
+    return w_sorted[order]

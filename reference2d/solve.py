@@ -67,6 +67,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
             progress(state)
 
     limit_points = []
+    roundoff = newton_tol = None
     if a.kind == "linear":
         u1 = solve_linear(system, 1.0)
         lam = _linear_target(scene, system, u1)
@@ -77,11 +78,15 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
                              {n: float(system.probe_vector(n) @ u) for n in names}, None))
         converged, message = True, f"linear solution scaled to λ = {lam:.6g}"
     else:
+        # Newton cannot get the residual below the round-off of its own evaluation: ask for the
+        # scene's tolerance or that bound, whichever is larger (reported in the summary)
+        roundoff = system.residual_roundoff_bound()
+        newton_tol = max(a.tol, roundoff)
         options = PathOptions(
             control=a.control, until_load_factor=a.until_load_factor,
             until_probe=a.until_probe, until_value=a.until_value, max_steps=a.max_steps,
             initial_increment=a.initial_increment, min_increment=a.min_increment,
-            max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations)
+            max_increment=a.max_increment, tol=newton_tol, max_iterations=a.max_iterations)
         result = follow_path(system, options, names, progress=record)
         converged, message = result.reached_target, result.message
         limit_points = result.limit_points
@@ -99,6 +104,9 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "newton_iterations": int(sum(r.iterations for r in rows)),
         "stress_measure": "second Piola-Kirchhoff, reference frame",
     }
+    if newton_tol is not None:
+        extra["newton_tol"] = float(newton_tol)
+        extra["residual_roundoff_bound"] = float(roundoff)
     solution = Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
                         limit_points, time.perf_counter() - t0, int(system.size), extra)
     if keep_states:  # not part of the result contract: kept off ``extra`` (summary.json)
