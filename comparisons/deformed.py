@@ -8,6 +8,9 @@ Drawing only: the von Mises stress comes from the model; deformation is drawn at
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -17,12 +20,61 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from comparisons.snapshots import FaceLines, FieldSnapshot  # noqa: E402
+from comparisons.snapshots import FaceLines, FieldSnapshot, save_snapshot  # noqa: E402
 
 
-def render_snapshot(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0,
-                    window: tuple[int, int] = (1600, 420)) -> Path:
-    """Render ``snapshot`` deformed (× ``scale``) and coloured by core von Mises into ``path``."""
+def render_snapshot(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0) -> Path:
+    """Render ``snapshot`` deformed (× ``scale``), coloured by core von Mises, into ``path``.
+
+    pyvista renders in a child process: VTK's wheel and the FEniCSx stack loaded in one process
+    have been seen to abort inside VTK (a C++ library clash). If the child fails, the picture is
+    drawn with matplotlib instead, and the title says so.
+    """
+    with tempfile.TemporaryDirectory() as tmp:
+        npz = save_snapshot(snapshot, Path(tmp))
+        cmd = [sys.executable, "-m", "comparisons.render_worker", str(npz), str(path),
+               snapshot.model, repr(scale)]
+        try:
+            done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+            ok = done.returncode == 0 and Path(path).is_file()
+        except (OSError, subprocess.TimeoutExpired):
+            ok = False
+    return path if ok else draw_snapshot(snapshot, path, scale=scale, note="pyvista failed; ")
+
+
+def draw_snapshot(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0,
+                  note: str = "") -> Path:
+    """Matplotlib picture of the deformed section, core cells coloured by von Mises."""
+    from matplotlib.collections import PolyCollection
+
+    xz = snapshot.points + scale * snapshot.displacement
+    vm = np.asarray(snapshot.von_mises, dtype=float)
+    if not snapshot.per_cell:
+        vm = vm[snapshot.cells].mean(axis=1)
+    region = snapshot.region if snapshot.region is not None else np.zeros(len(vm), dtype=int)
+    fig, ax = plt.subplots(figsize=(14, 3.6))
+    core = region == 0
+    polys = PolyCollection(xz[snapshot.cells[core]], array=vm[core], cmap="viridis",
+                           edgecolors="none")
+    ax.add_collection(polys)
+    ax.add_collection(PolyCollection(xz[snapshot.cells[~core]], facecolors="gray",
+                                     edgecolors="none"))
+    fig.colorbar(polys, ax=ax, label="core von Mises (MPa)", fraction=0.03)
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.set_title(f"{note}{snapshot.model}: step {snapshot.step}, "
+                 f"load factor {snapshot.load_factor:.4g}", fontsize=9)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def render_with_pyvista(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0,
+                        window: tuple[int, int] = (1600, 420)) -> Path:
+    """Render in this process with pyvista (off screen); see :func:`render_snapshot`."""
     import pyvista as pv
 
     pv.OFF_SCREEN = True

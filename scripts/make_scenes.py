@@ -105,6 +105,7 @@ def main():
     default = default.replace('name = "paper-fig5-top-debond-40-load-top"', 'name = "default"')
     default = default.replace("value = -15", "value = -8")
     default = default.replace('description = "', 'description = "default demo scene: ', 1)
+    default += '\n[reference2d]\nlevel = "coarse"   # keeps the demo to a couple of minutes\n'
     (OUT / "default.toml").write_text(default)
 
 
