@@ -4,9 +4,9 @@ Slave nodes are the face-lip nodes; each is paired with the coincident core-lip 
 x_0). The master surface near the anchor is the tangent line of the deformed core lip there, with
 its direction taken from the chord of the anchor's two neighbours on the core lip, x_1 → x_2
 (the crack-tip nodes close the chain; at an open mouth, where the debond reaches the beam
-end, the last chord is one-sided: the anchor and its single neighbour). The gap is the signed distance of the slave
-from that line along its normal n = J (x_2 − x_1)/|x_2 − x_1|, J a +90° rotation, the chain being
-ordered so that n points out of the core:
+end, the last chord is one-sided: the anchor and its single neighbour). The gap is the signed
+distance of the slave from that line along its normal n = J (x_2 − x_1)/|x_2 − x_1|, J a +90°
+rotation, the chain being ordered so that n points out of the core:
 
     g = n · (x_s − x_0) = (x_2 − x_1) × (x_s − x_0) / |x_2 − x_1|.
 

@@ -73,7 +73,7 @@ class MumpsSolver:
         return int(F.getMumpsInfog(12))
 
     def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
-        """x = K⁻¹ b with the current factorisation."""
+        """X = K⁻¹ b with the current factorisation."""
         self.ksp.solve(b, x)
 
     def reset(self) -> None:
@@ -92,7 +92,7 @@ class MumpsFactorization:
     solving, so a stale handle never solves with another state's factors.
     """
 
-    def __init__(self, system: "Reference2DSystem", u: np.ndarray | None):
+    def __init__(self, system: Reference2DSystem, u: np.ndarray | None):
         self.system = system
         self.u = None if u is None else np.array(u, dtype=float)
         self._neg = system._factor_current()
@@ -214,8 +214,10 @@ class Reference2DSystem:
         return A
 
     def factorize(self, K: PETSc.Mat) -> MumpsFactorization:
-        """LDLᵀ with MUMPS (symmetric indefinite), inertia reported; ``K`` is the model's matrix
-        as returned by :meth:`tangent` (its values are factorised now)."""
+        """LDLᵀ with MUMPS (symmetric indefinite), inertia reported.
+
+        ``K`` is the model's matrix as returned by :meth:`tangent` (its values are factorised now).
+        """
         if K is not self.A:
             raise ValueError("factorize expects the matrix returned by tangent()")
         return MumpsFactorization(self, self._tangent_u)
@@ -263,8 +265,10 @@ class Reference2DSystem:
         return A
 
     def residual_roundoff_bound(self) -> float:
-        """ε ‖ |K(0)| |u₁| ‖ / ‖f_ref‖ with u₁ = K(0)⁻¹ f_ref: the a-priori bound of the round-off
-        in evaluating the residual, relative to the load (scale-free along the linear range).
+        """Round-off bound of the residual relative to the load: ε ‖ |K(0)| |u₁| ‖ / ‖f_ref‖.
+
+        u₁ = K(0)⁻¹ f_ref; the a-priori bound of the round-off in evaluating the residual, scale-
+        free along the linear range.
 
         The through-thickness stiffness of thin face elements (E b l / h ~ 1e8 N/mm) times the ulp
         of the displacement makes this 1e-8…1e-7 on the paper scenes, at or above the default

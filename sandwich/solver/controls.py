@@ -23,12 +23,19 @@ roots); the corrector then reports a failure.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
 __all__ = ["ArcLengthConstraint", "Constraint", "LoadConstraint", "ProbeConstraint"]
+
+Dot = Callable[[np.ndarray, np.ndarray], float]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    return float(a @ b)
 
 
 class Constraint(Protocol):
@@ -82,6 +89,7 @@ class ProbeConstraint:
 
     c: np.ndarray
     target: float
+    dot: Dot | None = None  # the system's global inner product (MPI); default a @ b
 
     def delta_lambda(
         self,
@@ -93,11 +101,12 @@ class ProbeConstraint:
         delta_lambda: float,
     ) -> float | None:
         """Return the δλ that puts the linearised probe on ``target``."""
-        cf = float(self.c @ du_f)
-        scale = float(np.linalg.norm(self.c) * np.linalg.norm(du_f))
+        dot = self.dot or _dot
+        cf = dot(self.c, du_f)
+        scale = math.sqrt(max(dot(self.c, self.c), 0.0) * max(dot(du_f, du_f), 0.0))
         if not math.isfinite(cf) or abs(cf) <= 1e-13 * scale or scale == 0.0:
             return None  # the probe does not respond to the load: a turning point of the probe
-        return (self.target - float(self.c @ u) - float(self.c @ du_r)) / cf
+        return (self.target - dot(self.c, u) - dot(self.c, du_r)) / cf
 
 
 @dataclass(frozen=True)
@@ -114,6 +123,7 @@ class ArcLengthConstraint:
 
     radius: float
     psi: float
+    dot: Dot | None = None  # the system's global inner product (MPI); default a @ b
 
     def delta_lambda(
         self,
@@ -125,11 +135,12 @@ class ArcLengthConstraint:
         delta_lambda: float,
     ) -> float | None:
         """Return the root of the quadratic arc equation closest in angle to the last increment."""
+        dot = self.dot or _dot
         psi2 = self.psi * self.psi
         w = delta_u + du_r
-        a = float(du_f @ du_f) + psi2
-        b = 2.0 * (float(du_f @ w) + psi2 * delta_lambda)
-        c = float(w @ w) + psi2 * delta_lambda * delta_lambda - self.radius * self.radius
+        a = dot(du_f, du_f) + psi2
+        b = 2.0 * (dot(du_f, w) + psi2 * delta_lambda)
+        c = dot(w, w) + psi2 * delta_lambda * delta_lambda - self.radius * self.radius
         disc = b * b - 4.0 * a * c
         if not (math.isfinite(disc) and a > 0.0):
             return None
@@ -142,11 +153,11 @@ class ArcLengthConstraint:
         q = -0.5 * (b + math.copysign(sq, b))  # numerically stable roots
         roots = [q / a, c / q] if q != 0.0 else [0.0]
         # Crisfield's angle criterion: maximise the projection of the new increment on the old.
-        old_norm2 = float(delta_u @ delta_u) + psi2 * delta_lambda * delta_lambda
+        old_norm2 = dot(delta_u, delta_u) + psi2 * delta_lambda * delta_lambda
 
         def projection(dl: float) -> float:
             new_u = w + dl * du_f
-            return float(new_u @ delta_u) + psi2 * (delta_lambda + dl) * delta_lambda
+            return dot(new_u, delta_u) + psi2 * (delta_lambda + dl) * delta_lambda
 
         if old_norm2 == 0.0:
             return min(roots, key=abs)

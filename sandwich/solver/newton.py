@@ -24,7 +24,7 @@ import numpy as np
 
 from sandwich.solver.controls import Constraint, LoadConstraint
 from sandwich.solver.sparse import SingularTangentError
-from sandwich.solver.system import DiscreteSystem, Factorization
+from sandwich.solver.system import DiscreteSystem, Factorization, inner_product
 
 __all__ = ["NewtonResult", "NewtonSettings", "newton_correct", "solve_equilibrium"]
 
@@ -67,8 +67,9 @@ class NewtonResult:
     factorization: Factorization | None = None
 
 
-def _norm(v: np.ndarray, lam: float, psi: float) -> float:
-    return math.sqrt(float(v @ v) + (psi * lam) ** 2)
+def _norm(v: np.ndarray, lam: float, psi: float, dot=None) -> float:
+    vv = dot(v, v) if dot is not None else float(v @ v)
+    return math.sqrt(vv + (psi * lam) ** 2)
 
 
 def newton_correct(
@@ -101,6 +102,11 @@ def newton_correct(
     NewtonResult
         Converged or not; ordinary divergence is reported, not raised.
     """
+    dot = inner_product(system)
+
+    def norm(v: np.ndarray) -> float:  # nan/inf propagate; collective when dot is
+        return math.sqrt(dot(v, v))
+
     f_ref = np.asarray(system.f_ref, dtype=float)
     u0 = np.array(u, dtype=float) if u_start is None else np.asarray(u_start, dtype=float)
     lam0 = float(load_factor) if load_factor_start is None else float(load_factor_start)
@@ -122,13 +128,13 @@ def newton_correct(
             except RECOVERABLE_ERRORS as exc:
                 return fail(f"internal force failed: {exc}", it)
             res = f_int - lam * f_ref
-            r_norm = float(np.linalg.norm(res))
+            r_norm = norm(res)
             if not math.isfinite(r_norm):
                 return fail("non-finite residual", it)
-            scale = max(abs(lam) * float(np.linalg.norm(f_ref)), float(np.linalg.norm(f_int)),
+            scale = max(abs(lam) * norm(f_ref), norm(f_int),
                         settings.force_floor, _TINY)
             if last_step is not None:
-                inc_scale = max(_norm(u - u0, lam - lam0, psi), _norm(u, lam, psi))
+                inc_scale = max(_norm(u - u0, lam - lam0, psi, dot), _norm(u, lam, psi, dot))
                 if r_norm <= settings.tol * scale and last_step <= tol_inc * inc_scale:
                     try:
                         fac = system.factorize(system.tangent(u))
@@ -151,11 +157,11 @@ def newton_correct(
             if dlam is None or not math.isfinite(dlam):
                 return fail("the control equation has no solution at this iterate", it)
             du = du_r + dlam * du_f
-            if not np.all(np.isfinite(du)):
+            if not math.isfinite(dot(du, du)):
                 return fail("non-finite correction", it)
             u = u + du
             lam = lam + dlam
-            last_step = _norm(du, dlam, psi)
+            last_step = _norm(du, dlam, psi, dot)
     return fail(
         f"no convergence in {settings.max_iterations} iterations (residual {r_norm:.3e})",
         settings.max_iterations,

@@ -32,7 +32,7 @@ from sandwich.results import LimitPoint
 from sandwich.solver.controls import ArcLengthConstraint, LoadConstraint, ProbeConstraint
 from sandwich.solver.limits import find_limit_points
 from sandwich.solver.newton import RECOVERABLE_ERRORS, NewtonSettings, newton_correct
-from sandwich.solver.system import DiscreteSystem, Factorization
+from sandwich.solver.system import DiscreteSystem, Factorization, inner_product
 
 __all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linear"]
 
@@ -170,6 +170,7 @@ class _Follower:
         progress: Callable[[PathState], None] | None,
     ) -> None:
         self.system = system
+        self.dot = inner_product(system)  # global over MPI ranks if the system provides it
         self.opt = options
         self.progress = progress
         names = list(dict.fromkeys([*probe_names, *(n for n in (options.until_probe,
@@ -180,10 +181,10 @@ class _Follower:
 
     # -- helpers -------------------------------------------------------------------------------
     def probes(self, u: np.ndarray) -> dict[str, float]:
-        return {n: float(c @ u) for n, c in self.c.items()}
+        return {n: self.dot(c, u) for n, c in self.c.items()}
 
     def wnorm(self, du: np.ndarray, dlam: float) -> float:
-        return math.sqrt(float(du @ du) + (self.psi * dlam) ** 2)
+        return math.sqrt(self.dot(du, du) + (self.psi * dlam) ** 2)
 
     def accept(self, u: np.ndarray, lam: float, its: int, neg: int | None, cuts: int) -> None:
         state = PathState(len(self.states), u.copy(), float(lam), its, self.probes(u), neg, cuts)
@@ -206,7 +207,7 @@ class _Follower:
             self.accept(u0, 0.0, 0, None, 0)
             return self.finish(False, f"step 1: the initial tangent cannot be factorised ({exc})")
         self.accept(u0, 0.0, 0, fac.negative_pivots, 0)
-        tn = float(np.linalg.norm(t))
+        tn = math.sqrt(self.dot(t, t))
         if not math.isfinite(tn) or tn == 0.0:
             return self.finish(False, "step 1: f_ref is zero or the linear solution is not finite")
         self.psi = opt.arc_load_weight * tn
@@ -226,7 +227,7 @@ class _Follower:
         self.prev_step: tuple[np.ndarray, float] | None = None
         self.sigma = 1.0 if self.lam_est >= 0 else -1.0
         if opt.control == "displacement":  # move the probe the way the load would move it
-            ct = float(self.c[opt.driven_probe] @ t)
+            ct = self.dot(self.c[opt.driven_probe], t)
             self.sigma = math.copysign(1.0, ct * self.lam_est) if ct != 0.0 else 1.0
         self.newton = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations,
                                      psi=self.psi)
@@ -298,7 +299,7 @@ class _Follower:
         if self.opt.until_load_factor is not None:
             ests.append(self.opt.until_load_factor)
         if self.opt.until_probe is not None:
-            ct = float(self.c[self.opt.until_probe] @ t)
+            ct = self.dot(self.c[self.opt.until_probe], t)
             if ct != 0.0:
                 ests.append(self.opt.until_value / ct)
         return min(ests, key=abs) if ests else 1.0
@@ -312,8 +313,8 @@ class _Follower:
             name = self.opt.driven_probe
             if name == self.opt.until_probe:
                 return abs(self.opt.until_value) / 20.0
-            return abs(float(self.c[name] @ t)) * lam / 20.0 or lam / 20.0
-        return lam * math.sqrt(float(t @ t) + self.psi**2) / 20.0
+            return abs(self.dot(self.c[name], t)) * lam / 20.0 or lam / 20.0
+        return lam * math.sqrt(self.dot(t, t) + self.psi**2) / 20.0
 
     def _clip_to_target(self, h: float, last: PathState) -> tuple[float, bool]:
         """Shorten ``h`` so that a directly controlled target is hit exactly.
@@ -345,7 +346,7 @@ class _Follower:
         if self.prev_step is None:
             return self.sigma
         du, dl = self.prev_step
-        dot = float(t @ du) + self.psi**2 * dl
+        dot = self.dot(t, du) + self.psi**2 * dl
         denom = self.wnorm(t, 1.0) * self.wnorm(du, dl)
         prev = self.states[-2] if len(self.states) >= 2 else None
         if denom > 0.0 and abs(dot) >= 0.1 * denom:
@@ -367,17 +368,17 @@ class _Follower:
         elif opt.control == "displacement":
             name = opt.driven_probe
             c = self.c[name]
-            ct = float(c @ t)
+            ct = self.dot(c, t)
             v0 = last.probes[name]
             target = (opt.until_value if name == opt.until_probe
                       and h == abs(opt.until_value - v0) else v0 + self.sigma * h)
             if ct == 0.0 or not math.isfinite(ct):
                 return None, f"probe {name} does not respond to the load"
             dlam = (target - v0) / ct
-            constraint = ProbeConstraint(c, target)
+            constraint = ProbeConstraint(c, target, self.dot)
         else:
             dlam = self.sigma * h / self.wnorm(t, 1.0)
-            constraint = ArcLengthConstraint(h, self.psi)
+            constraint = ArcLengthConstraint(h, self.psi, self.dot)
         du_pred = dlam * t
         pred_len = self.wnorm(du_pred, dlam)
         if self.prev_step is not None:
@@ -385,7 +386,8 @@ class _Follower:
             if pred_len > opt.max_predictor_growth * prev_len:
                 return None, (f"predictor {pred_len:.3g} longer than {opt.max_predictor_growth}"
                               f" × the previous step {prev_len:.3g}")
-        floor = float(np.linalg.norm(self.f_ref)) * max(abs(s.load_factor) for s in self.states)
+        floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
+                 * max(abs(s.load_factor) for s in self.states))
         settings = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations, psi=self.psi,
                                   force_floor=floor)
         res = newton_correct(self.system, last.u + du_pred, last.load_factor + dlam, constraint,
@@ -407,14 +409,14 @@ class _Follower:
         if self.opt.until_probe is not None:
             c = self.c[self.opt.until_probe]
             pairs.append((self.opt.until_probe, self.opt.until_value,
-                          last.probes[self.opt.until_probe], float(c @ trial.u)))
+                          last.probes[self.opt.until_probe], self.dot(c, trial.u)))
         for name, target, a, b in pairs:
             if (a - target) * (b - target) <= 0.0 and a != b:
                 out.append(((target - a) / (b - a), name, target))
         return sorted(out)
 
     def _value(self, name: str, u: np.ndarray, lam: float) -> float:
-        return lam if name == "λ" else float(self.c[name] @ u)
+        return lam if name == "λ" else self.dot(self.c[name], u)
 
     def _hit_crossed_target(
         self, trial: _Trial, h: float, last: PathState, t: np.ndarray

@@ -6,10 +6,15 @@ already eliminated) as
     R(u, λ) = f_int(u) − λ f_ref = 0,
 
 with ``f_ref`` the reference (dead) load of the scene and λ the load factor.
+
+A system distributed over MPI ranks (each rank holding its owned entries of every vector) may
+also provide ``dot(a, b) -> float``, the global inner product; the solver then uses it for every
+inner product and norm (:func:`inner_product`), and falls back to ``float(a @ b)`` without it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -60,3 +65,13 @@ class DiscreteSystem(Protocol):
     def commit(self, u: np.ndarray, load_factor: float) -> None:
         """Accept a converged state (update history variables such as contact status)."""
         ...
+
+
+def _local_dot(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.asarray(a) @ np.asarray(b))
+
+
+def inner_product(system: object) -> Callable[[np.ndarray, np.ndarray], float]:
+    """The system's optional ``dot(a, b)`` (global over MPI ranks), else ``float(a @ b)``."""
+    dot = getattr(system, "dot", None)
+    return dot if callable(dot) else _local_dot

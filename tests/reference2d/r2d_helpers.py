@@ -50,15 +50,15 @@ def strip_scene(debonds, E=100.0, nu=0.3, t_face=0.5, t_core=4.0, length=20.0, w
                  Analysis(kind="linear", until_load_factor=1.0))
 
 
-def pressed_strip(debonded: bool, pressure: float, nx=20, penalty=None):
+def pressed_strip(debonded: bool, pressure: float, nx=20, penalty=None, span=(5.0, 15.0)):
     """The strip on a frictionless floor (w = 0 on z = bottom, u = 0 at one bottom node), uniform
     pressure ``pressure`` (MPa, positive pushes down) on the whole top edge. Debond: top
-    interface, x in [5, 15]. Returns (system, model pieces)."""
+    interface, x in ``span`` (reaching x = 0 or 20: open mouth). Returns (system, pairs)."""
     from reference2d.model import contact_pairs, default_penalty, layer_bands
 
-    scene = strip_scene([(5.0, 15.0)] if debonded else [])
+    scene = strip_scene([span] if debonded else [])
     layers = [("bottom", 0.5, 1), ("core", 4.0, 4), ("top", 0.5, 1)]
-    mesh = layered_mesh(20.0, layers, nx, debonds=[("top", 5.0, 15.0)] if debonded else [])
+    mesh = layered_mesh(20.0, layers, nx, debonds=[("top", *span)] if debonded else [])
     disc = build_discretisation(mesh.points, mesh.cells)
     V = disc.V
     stiff = PlaneStressStiffness(disc.mesh, layer_bands(scene))

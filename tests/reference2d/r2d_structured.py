@@ -16,7 +16,9 @@ def layered_mesh(length, layers, nx, debonds=(), x0=0.0):
     """Structured 9-node quads.
 
     layers: list of (name, thickness, elements through thickness), bottom first.
-    debonds: list of (interface "top"|"bottom", start, end) on element boundaries.
+    debonds: list of (interface "top"|"bottom", start, end) on element boundaries. A debond
+    reaching a beam end (start <= x0 or end >= x0 + length) has an open mouth there: the end
+    node is a lip pair too, as in ``meshes.build_mesh``.
     """
     z = [0.0]
     z_layer = []
@@ -38,7 +40,9 @@ def layered_mesh(length, layers, nx, debonds=(), x0=0.0):
     for k, (iface, a, b) in enumerate(debonds):
         ci = names.index("core")
         iz = bounds[ci + 1] if iface == "top" else bounds[ci]
-        inside = [ix for ix in range(nxn) if a + 1e-9 < xs[ix] < b - 1e-9]
+        lo = a - 1e-9 if a <= x0 + 1e-9 else a + 1e-9  # open mouth: the end node splits too
+        hi = b + 1e-9 if b >= x0 + length - 1e-9 else b - 1e-9
+        inside = [ix for ix in range(nxn) if lo < xs[ix] < hi]
         new = np.arange(len(points), len(points) + len(inside))
         points = np.vstack([points, points[idx[inside, iz]]])
         face_map = dict(zip(inside, new, strict=True))

@@ -66,3 +66,51 @@ def test_newton_converges_quadratically_with_contact_active():
     assert big, rel
     for i in big:
         assert np.log(rel[i + 1]) / np.log(rel[i]) > 1.8
+
+
+# Open mouth: a debond reaching the beam end (x = 0 here) has no crack tip there; the end lip
+# node is a slave with the one-sided Simpson weight h/6 and a one-sided master chord. Reference:
+# the same strip bonded (a closed crack transmits the normal load unchanged, as in the tests
+# above) and the applied pressure (uniform, so every lip node must carry it).
+MOUTH = (0.0, 6.0)
+
+
+def test_open_mouth_weights_integrate_the_lip_length():
+    _, pairs = pressed_strip(True, PRESSURE, span=MOUTH)
+    (pair,) = pairs
+    assert len(pair.slave) == 12  # x = 0 (mouth corner) … 5.5; x = 6 is the tip
+    assert pair.weight.sum() == pytest.approx(6.0 - 1.0 / 6.0)  # tip's h/6 is bonded
+    i0 = int(np.argmin(pair.x_ref))
+    assert pair.x_ref[i0] == 0.0 and pair.weight[i0] == pytest.approx(1.0 / 6.0)
+
+
+def test_closed_open_mouth_debond_gives_the_bonded_normal_response():
+    bonded, _ = pressed_strip(False, PRESSURE)
+    cut, _ = pressed_strip(True, PRESSURE, span=MOUTH)
+    ub, _ = _solve(bonded, 1.0)
+    uc, _ = _solve(cut, 1.0)
+    state = cut.last_contact[0]
+    print(f"p = {state.pressure.min():.5g}..{state.pressure.max():.5g}, "
+          f"penetration {-state.gap.min():.3g}")
+    assert np.all(state.pressure > 0)  # the mouth node included
+    assert state.pressure == pytest.approx(PRESSURE, rel=3e-3)
+    assert -state.gap.min() <= 1e-3 * 0.5
+    def top_edge_w(system, u):  # w along the loaded edge, by x (the two meshes number apart)
+        X = system.x_ref
+        top = np.where(np.abs(X[:, 1] - 2.5) < 1e-7)[0]
+        top = top[np.argsort(X[top, 0])]
+        return X[top, 0], u[2 * top + 1]
+
+    xb, wb = top_edge_w(bonded, ub)
+    xc, wc = top_edge_w(cut, uc)
+    assert np.array_equal(xb, xc)
+    assert np.max(np.abs(wc - wb)) <= 2 * -state.gap.min() + 1e-9 * np.max(np.abs(wb))
+
+
+def test_opening_open_mouth_debond_carries_no_pressure():
+    cut, _ = pressed_strip(True, -PRESSURE, span=MOUTH)
+    _solve(cut, 1.0)
+    state = cut.last_contact[0]
+    print(f"gaps {state.gap.min():.4g}..{state.gap.max():.4g}")
+    assert np.all(state.pressure == 0.0)
+    assert np.all(state.gap >= 0.0) and state.gap.max() > 1e-3
