@@ -2,8 +2,9 @@
 
 Runs the fig4 and fig5 paper scenes (path shortened to w_top_mid = UNTIL mm unless --full) and
 times where the work goes: residual assembly, tangent assembly (incl. contact), MUMPS
-factorisation, contact evaluation. Serial only: the 2D reference does not run on several MPI
-ranks yet (see docs/reference2d.md). Writes benchmarks/results/reference2d/speed.{md,json}.
+factorisation (numeric only after the first: the symbolic analysis is reused), contact
+evaluation. Serial only (see docs/reference2d.md on MPI). Writes
+benchmarks/results/reference2d/speed.{md,json}.
 
     XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/reference2d_speed.py [--levels coarse medium]
 """
@@ -44,11 +45,11 @@ class Timers:
         return timed
 
 
-def run(name, level, full):
+def run(name, level, full, until=UNTIL):
     scene = load_scene(ROOT / "scenes" / f"{name}.toml")
     if not full:
         scene = dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
-                                                                        until_value=UNTIL))
+                                                                        until_value=until))
     timers = Timers()
     build = model_mod.build_model
 
@@ -87,25 +88,27 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--levels", nargs="+", default=["coarse", "medium"])
     p.add_argument("--full", action="store_true", help="the scenes' full paths")
+    p.add_argument("--until", type=float, default=UNTIL, help="w_top_mid target (mm)")
+    p.add_argument("--out", default="speed", help="file stem under benchmarks/results/reference2d")
     args = p.parse_args()
     rows = []
     for name in SCENES:
         for level in args.levels:
-            r = run(name, level, args.full)
+            r = run(name, level, args.full, args.until)
             print(r, flush=True)
             rows.append(r)
     OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "speed.json").write_text(json.dumps(rows, indent=2) + "\n")
+    (OUT / f"{args.out}.json").write_text(json.dumps(rows, indent=2) + "\n")
     head = ("| scene | level | ranks | DOFs | steps | Newton its | s/step | residual s | "
             "tangent s | factorise s | contact s | total s |")
-    lines = [f"Path to w_top_mid = {'target' if args.full else UNTIL} mm, serial.", "", head,
+    lines = [f"Path to w_top_mid = {'target' if args.full else args.until} mm, serial.", "", head,
              "|" + "---|" * 12]
     for r in rows:
         lines.append(f"| {r['scene']} | {r['level']} | {r['ranks']} | {r['dofs']} | {r['steps']} "
                      f"| {r['newton_iterations']} | {r['s_per_step']:.3f} | {r['residual_s']:.1f} "
                      f"| {r['tangent_s']:.1f} | {r['factorize_s']:.1f} | {r['contact_s']:.2f} "
                      f"| {r['wall_s']:.1f} |")
-    (OUT / "speed.md").write_text("\n".join(lines) + "\n")
+    (OUT / f"{args.out}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.io import XDMFFile
@@ -51,3 +52,65 @@ def write_fields(solution, path: str | Path, every: int = 1) -> Path:
                 f.interpolate(expr)
                 xdmf.write_function(f, float(step))
     return path
+
+
+# gmsh quad9 (corners 0-3, mid-sides 4-7, centre 8) split into four counter-clockwise sub-quads
+QUAD9_SUBQUADS = np.array([[0, 4, 8, 7], [4, 1, 5, 8], [8, 5, 2, 6], [7, 8, 6, 3]])
+REGION_OF_BAND = {"core": 0, "top": 1, "bottom": 2}  # FieldFrame region codes
+
+
+def cauchy_cell_values(model, u: np.ndarray) -> dict[str, np.ndarray]:
+    """Cell-centre (DG0) Cauchy stresses σ = F S Fᵀ / det F at state ``u``, per local cell."""
+    msh = model.disc.mesh
+    system = model.system
+    system._set_u(u)
+    uf = system.u
+    F = deformation_gradient(uf)
+    S = model.stiffness.pk2(green_lagrange(uf))
+    sigma = F * S * F.T / ufl.det(F)
+    vm = ufl.sqrt(sigma[0, 0] ** 2 - sigma[0, 0] * sigma[1, 1] + sigma[1, 1] ** 2
+                  + 3 * sigma[0, 1] ** 2)
+    Q0 = fem.FunctionSpace(msh, ("DG", 0))
+    pts = Q0.element.interpolation_points()
+    n = msh.topology.index_map(2).size_local
+    out = {}
+    for name, expr in (("sigma_x", sigma[0, 0]), ("sigma_z", sigma[1, 1]),
+                       ("tau", sigma[0, 1]), ("von_mises", vm)):
+        f = fem.Function(Q0)
+        f.interpolate(fem.Expression(expr, pts))
+        dofs = np.array([Q0.dofmap.cell_dofs(c)[0] for c in range(n)])
+        out[name] = f.x.array[dofs].copy()
+    return out
+
+
+def field_frame(model, step: int, load_factor: float, u: np.ndarray):
+    """A :class:`sandwich.results.FieldFrame` of state ``u`` on the input mesh (serial only).
+
+    Points are the input mesh's nodes (x, z), each 9-node quad split into 4 counter-clockwise
+    sub-quads; point data ``displacement``; cell data (per sub-quad, the parent cell's centre
+    value) ``sigma_x``, ``sigma_z``, ``tau``, ``von_mises`` (Cauchy, MPa) and ``region``
+    (0 core, 1 top face, 2 bottom face).
+    """
+    from reference2d.model import layer_bands
+    from sandwich.results import FieldFrame
+
+    msh = model.disc.mesh
+    if msh.comm.size > 1:
+        raise NotImplementedError("field frames are built in serial runs only")
+    points = np.asarray(model.mesh.points, dtype=float)[:, :2]
+    cells9 = np.asarray(model.mesh.cells, dtype=np.int64)
+    blocks = model.disc.blocks(np.arange(len(points)))
+    disp = np.asarray(u).reshape(-1, 2)[blocks]
+    # input cell -> dolfinx cell, matched by the set of input node indices
+    inputs = msh.geometry.input_global_indices
+    dm = msh.geometry.dofmap
+    n = msh.topology.index_map(2).size_local
+    by_nodes = {frozenset(int(inputs[g]) for g in dm.links(c)): c for c in range(n)}
+    order = np.array([by_nodes[frozenset(map(int, c))] for c in cells9])
+    values = cauchy_cell_values(model, u)
+    names = [b.name for b in layer_bands(model.scene)]
+    region = np.array([REGION_OF_BAND[names[k]] for k in model.stiffness.layer_index[:n]])
+    sub = cells9[:, QUAD9_SUBQUADS].reshape(-1, 4)
+    cell_data = {k: np.repeat(v[order], 4) for k, v in values.items()}
+    cell_data["region"] = np.repeat(region[order], 4).astype(np.int32)
+    return FieldFrame(int(step), float(load_factor), points, sub, disp, {}, cell_data)

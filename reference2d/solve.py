@@ -109,6 +109,11 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         extra["residual_roundoff_bound"] = float(roundoff)
     solution = Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
                         limit_points, time.perf_counter() - t0, int(system.size), extra)
+    if states and model.disc.mesh.comm.size == 1:  # the last state for ParaView (VTU + PVD)
+        from reference2d.fields import field_frame
+
+        step, lf, u_last = states[-1]
+        solution.fields = [field_frame(model, step, lf, u_last)]
     if keep_states:  # not part of the result contract: kept off ``extra`` (summary.json)
         solution.reference2d_states = (model, states)
     return solution

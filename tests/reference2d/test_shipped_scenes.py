@@ -60,3 +60,38 @@ def test_shipped_scene_coarse_full_path(name):
     scene = load_scene(SCENES / f"{name}.toml")
     sol = solve(scene, level="coarse")
     check_reached(sol, scene)
+
+
+def test_solution_carries_a_paraview_frame_of_the_last_step(tmp_path):
+    """FieldFrame of the last state: 4 CCW sub-quads per 9-node cell, displacement equal to the
+    probe (reference: the history row), regions, Cauchy stresses; written as VTU + PVD."""
+    from sandwich.results import write_solution
+
+    scene = load_scene(shortened_copy("paper-fig4-bonded-3pb", tmp_path, 0.1))
+    sol = solve(scene, level="coarse")
+    assert sol.converged and len(sol.fields) == 1
+    fr = sol.fields[0]
+    assert fr.step == sol.history[-1].step and fr.load_factor == sol.history[-1].load_factor
+    assert len(fr.cells) == 4 * sol.extra["cells"]
+    p = fr.points[fr.cells]  # (m, 4, 2): shoelace area > 0 for every sub-quad
+    area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, 1)
+                        - np.roll(p[:, :, 0], -1, 1) * p[:, :, 1], axis=1)
+    assert np.all(area > 0)
+    assert area.sum() == pytest.approx(scene.length * (scene.top.thickness + scene.core.thickness
+                                                       + scene.bottom.thickness), rel=1e-9)
+    z_mid = 0.5 * (scene.core.thickness + scene.top.thickness)  # the probe: top face mid-surface
+    i = np.argmin(np.hypot(fr.points[:, 0] - 150.0, fr.points[:, 1] - z_mid))
+    assert fr.points[i] == pytest.approx([150.0, z_mid])
+    assert fr.displacement[i, 1] == pytest.approx(sol.history[-1].probes["w_top_mid"], rel=1e-9)
+    assert set(np.unique(fr.cell_data["region"])) == {0, 1, 2}
+    for k in ("sigma_x", "sigma_z", "tau", "von_mises"):
+        assert np.all(np.isfinite(fr.cell_data[k]))
+    assert np.all(fr.cell_data["von_mises"] >= 0)
+    # faces (region 1, 2) carry the bending: |σx| there far above the core's
+    faces = np.abs(fr.cell_data["sigma_x"][fr.cell_data["region"] > 0]).max()
+    core = np.abs(fr.cell_data["sigma_x"][fr.cell_data["region"] == 0]).max()
+    assert faces > 10 * core
+    files = write_solution(sol, tmp_path / "out")
+    names = {Path(f).name for f in files}
+    assert "fields.pvd" in names and any(n.endswith(".vtu") for n in names)
+    assert all(isinstance(v, (int, float, str, bool)) or v is None for v in sol.extra.values())
