@@ -53,7 +53,13 @@ def run(tmp_path_factory):
     import sys
 
     sys.path.insert(0, str(Path(__file__).parent))
-    from conftest import fake_solvers, scene_copy
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "cmp_conftest", Path(__file__).with_name("conftest.py"))
+    helpers = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(helpers)
+    fake_solvers, scene_copy = helpers.fake_solvers, helpers.scene_copy
 
     tmp = tmp_path_factory.mktemp("gallery")
     scenes = [scene_copy(p.stem, tmp) for p in shipped_scenes(ROOT)]
