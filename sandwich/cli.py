@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import glob
+import os
 import sys
 import time
 import traceback
@@ -21,7 +22,7 @@ MODELS = ("beam", "2d")
 
 
 def _say(args: argparse.Namespace, msg: str) -> None:
-    if not getattr(args, "quiet", False):
+    if not getattr(args, "quiet", False) and mpi_rank() == 0:
         print(msg, flush=True)
 
 
@@ -65,12 +66,21 @@ def cmd_mesh(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def mpi_rank() -> int:
+    """Rank of this process under mpirun (0 when run alone), from the launcher's environment."""
+    for var in ("OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"):
+        if var in os.environ:
+            return int(os.environ[var])
+    return 0
+
+
 def run_model(scene: Scene, model: str, out: Path, *, quiet: bool = False,
               level: str | None = None, refine: int | None = None):
-    """Solve ``scene`` with ``model`` and write its result files into ``out``."""
+    """Solve ``scene`` with ``model`` and write its result files into ``out`` (rank 0 only)."""
     from sandwich.progress import PathProgress
     from sandwich.results import write_solution
 
+    quiet = quiet or mpi_rank() != 0
     with PathProgress(scene, f"{scene.name} [{model}]", quiet=quiet) as progress:
         if model == "beam":
             from beam_element import solve
@@ -78,7 +88,8 @@ def run_model(scene: Scene, model: str, out: Path, *, quiet: bool = False,
         else:
             from reference2d import solve
             solution = solve(scene, progress=progress, level=level, refine=refine)
-    write_solution(solution, out)
+    if mpi_rank() == 0:
+        write_solution(solution, out)
     return solution
 
 
