@@ -28,7 +28,7 @@ def test_singular_profile_average_converges_to_closed_form(n):
     at_pole = np.interp(a, c, avg)
     # the linear interpolant misses O(√h) of the integral next to the pole: 2√(2h) at most
     assert abs(at_pole - exact) <= 2.0 * np.sqrt(2 * h) / width
-    assert y.max() > 10 * exact  # while the raw peak is far above it and grows with n
+    assert y.max() > 4 * exact  # the raw peak, (h/2)^(-1/2), is far above it and grows
 
 
 def test_window_wider_than_profile_is_refused():
