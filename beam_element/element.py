@@ -43,6 +43,21 @@ def geometric_products(op: LayerOperators) -> GeometricProducts:
     )
 
 
+def _eta_average(op: LayerOperators, a: np.ndarray) -> np.ndarray:
+    """Gauss-weighted mean along η at each ξ of ``a`` (shape ``(E, G, ...)``), broadcast back.
+
+    The tensor rule orders points with η slowest (:func:`~beam_element.quadrature.tensor_rule`).
+    """
+    n_xi = np.unique(op.xi).size
+    n_eta = op.eta.size // n_xi
+    w = op.weight.reshape(n_eta, n_xi)
+    w = w / w.sum(axis=0, keepdims=True)
+    shape = a.shape
+    b = a.reshape(shape[0], n_eta, n_xi, *shape[2:])
+    mean = np.einsum("jk,ejk...->ek...", w, b)  # (E, n_xi, ...)
+    return np.broadcast_to(mean[:, None], b.shape).reshape(shape)
+
+
 def layer_response(
     op: LayerOperators,
     u_e: np.ndarray,
@@ -77,8 +92,11 @@ def layer_response(
     u_ref = u_e[:, op.dofs] * scale
     g = gradients(op, u_ref, lengths)
     ε = np.stack(green_lagrange(g), axis=-1)  # (E, G, 3), eq. (15)
-    σ = ε @ op.stiffness.T  # eq. (3): (σ_x, σ_z, τ), second Piola-Kirchhoff
     B = np.stack(strain_variations(op, g), axis=2)  # (E, G, 3, n): N̄, N̂, Ñ of eq. (17)
+    if op.membrane_average:  # option, not the paper: assumed ε_x = its η-mean (see LayerOperators)
+        ε[..., 0] = _eta_average(op, ε[..., 0])
+        B[:, :, 0, :] = _eta_average(op, B[:, :, 0, :])
+    σ = ε @ op.stiffness.T  # eq. (3): (σ_x, σ_z, τ), second Piola-Kirchhoff
     # b l h / 4 dξ dη of eq. (19), times the Gauss weights.
     dV = width * (0.5 * np.asarray(lengths))[:, None] * (0.5 * op.thickness) * op.weight[None, :]
     f = np.einsum("eg,egi,egia->ea", dV, σ, B)  # eq. (19)
@@ -89,7 +107,9 @@ def layer_response(
     # eq. (24), material part: Σ_g dV Bᵀ C B.
     K = np.matmul((B * dV[:, :, None, None]).reshape(E, 3 * G, n).transpose(0, 2, 1),
                   CB.reshape(E, 3 * G, n))
-    # eq. (24), geometric part with eq. (25): σ_x N̄' + σ_z N̂' + τ Ñ'.
+    # eq. (24), geometric part with eq. (25): σ_x N̄' + σ_z N̂' + τ Ñ'. With membrane_average,
+    # σ_x is constant along η, so Σ_η dV σ̄_x P.xx is exactly σ̄_x times the η-mean second
+    # variation of ε̄_x: the same line serves both.
     P = products if products is not None else geometric_products(op)
     dx, dz = g.dx, g.dz
     K += np.einsum("eg,gab->eab", dV * σ[..., 0] * dx**2, P.xx)
@@ -105,6 +125,8 @@ def layer_energy(
     u_ref = u_e[:, op.dofs] * op.x_slope_scale(lengths)
     g = gradients(op, u_ref, lengths)
     ε = np.stack(green_lagrange(g), axis=-1)
+    if op.membrane_average:
+        ε[..., 0] = _eta_average(op, ε[..., 0])
     σ = ε @ op.stiffness.T
     dV = width * (0.5 * np.asarray(lengths))[:, None] * (0.5 * op.thickness) * op.weight[None, :]
     return 0.5 * np.einsum("eg,egi,egi->e", dV, σ, ε)

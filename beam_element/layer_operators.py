@@ -48,6 +48,11 @@ class LayerOperators:
         Their derivatives with respect to η and ξ, shape ``(G, n)``.
     x_slope
         Boolean mask of x-slope DOFs, shape ``(n,)``.
+    membrane_average
+        Option, NOT the paper's element (default False): ε_x is replaced at every point by its
+        Gauss-weighted average along η at the same ξ (an assumed membrane strain). For a face,
+        u is linear in x, so only the ½ w,x² term changes: it becomes its element mean, which
+        removes the membrane locking of u-linear / w-cubic faces. Needs a tensor Gauss rule.
     """
 
     name: str
@@ -65,6 +70,7 @@ class LayerOperators:
     M_eta: np.ndarray
     M_xi: np.ndarray
     x_slope: np.ndarray
+    membrane_average: bool = False
 
     def at(self, eta: np.ndarray, xi: np.ndarray) -> LayerOperators:
         """The same layer's rows at other points (weights set to zero)."""
@@ -86,6 +92,7 @@ def build_layer_operators(
     gauss: tuple[int, int] | None = None,
     eta: np.ndarray | None = None,
     xi: np.ndarray | None = None,
+    membrane_average: bool = False,
 ) -> LayerOperators:
     """Build the rows of eq. (13) for one layer, at a Gauss rule or at given points.
 
@@ -101,6 +108,8 @@ def build_layer_operators(
         Orders (n_η, n_ξ) of a tensor Gauss rule; or give ``eta`` and ``xi`` instead.
     eta, xi
         Explicit points (same shape); their weights are zero.
+    membrane_average
+        See :class:`LayerOperators` (needs ``gauss``).
     """
     if not (np.isfinite(thickness) and thickness > 0):
         raise ValueError(f"{name} layer thickness must be positive, got {thickness!r}")
@@ -135,5 +144,5 @@ def build_layer_operators(
     return LayerOperators(
         name=name, dofs=dofs, thickness=float(thickness), z_bottom=float(z_bottom),
         stiffness=np.asarray(stiffness, dtype=float), eta=eta, xi=xi, weight=weight,
-        x_slope=x_slope, **rows,
+        x_slope=x_slope, membrane_average=bool(membrane_average and gauss is not None), **rows,
     )

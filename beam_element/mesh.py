@@ -1,9 +1,22 @@
-"""Nodes along the beam: a target element size, with nodes exactly at every special station.
+"""Nodes along the beam: exactly the requested element count, graded towards key stations.
 
-Special stations are the beam ends, debond ends, supports, load points and patch edges, and
-probes. Stations closer than ``merge_tol`` are merged. Each stretch between consecutive stations
-is divided uniformly into round(stretch / target size) elements (at least one), so every special
-station is a node and no sliver element appears.
+Stations are x positions that must be nodes: the beam ends, debond ends, supports, load points and
+patch edges, probes. A subset of them, the *refinement centres* (supports, debond tips, point
+loads and patch edges), attracts small elements.
+
+Element sizes follow a size function h(x) (mm):
+
+* ``uniform``: h = const;
+* ``graded`` (default): h(x) = min(h_max, h_min + (r − 1) d(x)), d = distance to the nearest
+  refinement centre, h_max = q · h_min. Elements next to a centre have length ≈ h_min and grow
+  geometrically by about r per element (``growth``, default 1.2, bounded by 1.3) until they reach
+  h_max (``size_ratio`` q, default 12). h_min is set by bisection so that ∫ dx / h = the requested
+  element count.
+
+Each stretch between consecutive stations receives a whole number of elements (≥ 1) by largest
+remainders of ∫ dx/h over it, so the total is **exactly** the requested count (ValueError if that
+is smaller than the number of stretches), and its nodes equidistribute ∫ dx/h, so every station is
+a node and sizes vary smoothly across stations.
 """
 
 from __future__ import annotations
@@ -12,6 +25,11 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+
+GRADINGS = ("graded", "uniform")
+DEFAULT_GROWTH = 1.2
+MAX_GROWTH = 1.3
+DEFAULT_SIZE_RATIO = 12.0
 
 
 @dataclass(frozen=True)
@@ -57,43 +75,123 @@ class BeamMesh:
         return e, float(np.clip(η, -1.0, 1.0))
 
 
+def _clean(points: Iterable[float], length: float, tol: float, what: str) -> np.ndarray:
+    pts = np.array(list(points), dtype=float)
+    if not np.all(np.isfinite(pts)):
+        raise ValueError(f"mesh {what} must be finite numbers")
+    outside = pts[(pts < -tol) | (pts > length + tol)]
+    if outside.size:
+        raise ValueError(f"{what} {outside.tolist()} lie outside the beam [0, {length}]")
+    return np.sort(np.clip(pts, 0.0, length))
+
+
+def _largest_remainders(share: np.ndarray, total: int) -> np.ndarray:
+    """Integers n_k ≥ 1 summing to ``total`` and close to the positive reals ``share``."""
+    k = share.size
+    if total < k:
+        raise ValueError(f"{total} elements cannot give every one of the {k} stretches between "
+                         "mesh stations an element; ask for more elements")
+    # Give each stretch one element, distribute the rest in proportion to what is left over.
+    extra = np.maximum(share - 1.0, 0.0)
+    rest = total - k
+    if extra.sum() <= 0:
+        extra = share.copy()
+    want = extra * rest / extra.sum()
+    n = np.floor(want).astype(int)
+    short = rest - int(n.sum())
+    if short > 0:
+        n[np.argsort(-(want - n), kind="stable")[:short]] += 1
+    return n + 1
+
+
 def build_mesh(
     length: float,
     elements: int,
     stations: Iterable[float] = (),
     merge_tol: float | None = None,
+    *,
+    centres: Iterable[float] | None = None,
+    grading: str = "graded",
+    growth: float = DEFAULT_GROWTH,
+    size_ratio: float = DEFAULT_SIZE_RATIO,
 ) -> BeamMesh:
-    """Nodes over [0, length] with about ``elements`` elements and a node at every station.
+    """Nodes over [0, length]: exactly ``elements`` elements and a node at every station.
 
     Parameters
     ----------
     length
         Beam length (mm), positive.
     elements
-        Target number of elements over the length (≥ 1).
+        Number of elements over the length (≥ the number of stretches between stations).
     stations
         x positions (mm) that must be nodes; each must lie in [0, length].
     merge_tol
         Stations closer than this are merged (default 1e-6 × length).
+    centres
+        Refinement centres for ``graded`` (default: the stations and the beam ends).
+    grading
+        ``"graded"`` or ``"uniform"`` (see the module docstring).
+    growth
+        Size growth per element away from a centre, in (1, 1.3].
+    size_ratio
+        Largest over smallest element size q ≥ 1 (``graded``).
     """
     if not (np.isfinite(length) and length > 0):
         raise ValueError(f"beam length must be positive, got {length!r}")
     if not (isinstance(elements, int | np.integer) and elements >= 1):
         raise ValueError(f"element count must be a positive integer, got {elements!r}")
+    if grading not in GRADINGS:
+        raise ValueError(f"grading must be one of {GRADINGS}, got {grading!r}")
+    if not (1.0 < growth <= MAX_GROWTH):
+        raise ValueError(f"growth must lie in (1, {MAX_GROWTH}], got {growth!r}")
+    if not size_ratio >= 1.0:
+        raise ValueError(f"size_ratio must be ≥ 1, got {size_ratio!r}")
     tol = 1e-6 * length if merge_tol is None else merge_tol
-    pts = np.array([0.0, length, *stations], dtype=float)
-    if not np.all(np.isfinite(pts)):
-        raise ValueError("mesh stations must be finite numbers")
-    outside = pts[(pts < -tol) | (pts > length + tol)]
-    if outside.size:
-        raise ValueError(f"stations {outside.tolist()} lie outside the beam [0, {length}]")
-    pts = np.sort(np.clip(pts, 0.0, length))
+    pts = _clean([0.0, length, *stations], length, tol, "stations")
     keep = np.concatenate([[True], np.diff(pts) > tol])
     pts = pts[keep]
     pts[-1] = length  # a station merged into the end keeps the end exact
-    h = length / elements
+    if grading == "uniform" or size_ratio == 1.0:
+        density = lambda x: np.ones_like(x)  # noqa: E731  (relative 1/h)
+    else:
+        c = _clean([0.0, length] if centres is None else [0.0, length, *centres], length, tol,
+                   "refinement centres")
+        c = np.unique(c)
+
+        def density(x: np.ndarray) -> np.ndarray:
+            # 1/h relative to h_min: h/h_min = min(q, 1 + (r − 1) d / h_min) — h_min set below.
+            d = np.min(np.abs(x[:, None] - c[None, :]), axis=1)
+            return d
+
+    # Fine sampling grid containing every station, for ∫ dx/h by the trapezoidal rule.
+    m = max(4000, 40 * int(elements))
+    grid = np.unique(np.concatenate([np.linspace(0.0, length, m + 1), pts]))
+    if grading == "uniform" or size_ratio == 1.0:
+        inv_h = np.full(grid.size, elements / length)
+    else:
+        d = density(grid)
+
+        def inverse_size(h_min: float) -> np.ndarray:
+            return 1.0 / np.minimum(size_ratio * h_min, h_min + (growth - 1.0) * d)
+
+        def count(h_min: float) -> float:
+            return float(np.sum(0.5 * (lambda v: v[1:] + v[:-1])(inverse_size(h_min)) * np.diff(grid)))
+
+        lo, hi = length / elements / size_ratio * 1e-3, length  # count(lo) > elements > count(hi)
+        for _ in range(200):
+            mid = np.sqrt(lo * hi)
+            lo, hi = (mid, hi) if count(mid) > elements else (lo, mid)
+            if hi / lo < 1 + 1e-12:
+                break
+        inv_h = inverse_size(np.sqrt(lo * hi))
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (inv_h[1:] + inv_h[:-1]) * np.diff(grid))])
+    at = np.interp(pts, grid, cum)
+    n = _largest_remainders(np.diff(at), int(elements))
     nodes = [pts[:1]]
-    for a, b in zip(pts[:-1], pts[1:], strict=True):
-        n = max(1, int(round((b - a) / h)))
-        nodes.append(np.linspace(a, b, n + 1)[1:])
+    for k, (a, b) in enumerate(zip(at[:-1], at[1:], strict=True)):
+        if grading == "uniform" or size_ratio == 1.0:  # exact equal division of the stretch
+            inner = np.linspace(pts[k], pts[k + 1], n[k] + 1)[1:-1]
+        else:
+            inner = np.interp(np.linspace(a, b, n[k] + 1)[1:-1], cum, grid)
+        nodes.append(np.concatenate([inner, pts[k + 1: k + 2]]))
     return BeamMesh(np.concatenate(nodes))

@@ -22,7 +22,7 @@ from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
 from beam_element.element import GeometricProducts, geometric_products, layer_response
 from beam_element.layer_operators import LayerOperators, build_layer_operators
 from beam_element.loads import patch_load, point_load, probe_row
-from beam_element.mesh import BeamMesh, build_mesh
+from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
 
 CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
@@ -197,11 +197,23 @@ def mesh_stations(scene: object) -> list[float]:
     """X positions that must be nodes: debond ends, supports, loads (patch edges), probes."""
     pts: list[float] = []
     for d in scene.debonds:
-        pts += [d.start, d.end]
+        if d.end > d.start:  # a zero-length debond unties no node: not a station
+            pts += [d.start, d.end]
     pts += [s.x for s in scene.supports]
     for load in scene.loads:
         pts += [load.x] if load.width == 0 else [*load.span, load.x]
     pts += [p.x for p in scene.probes]
+    return pts
+
+
+def refinement_centres(scene: object) -> list[float]:
+    """Where the graded mesh puts its smallest elements: supports, debond tips, load edges."""
+    pts: list[float] = [s.x for s in scene.supports]
+    for d in scene.debonds:
+        if d.end > d.start:
+            pts += [d.start, d.end]
+    for load in scene.loads:
+        pts += [load.x] if load.width == 0 else list(load.span)
     return pts
 
 
@@ -212,6 +224,10 @@ def build_model(
     gauss: dict[str, tuple[int, int]] | None = None,
     contact_penalty: float | None = None,
     contact_smoothing: float | None = None,
+    grading: str = "graded",
+    growth: float = DEFAULT_GROWTH,
+    size_ratio: float = DEFAULT_SIZE_RATIO,
+    face_membrane: str = "paper",
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -220,7 +236,7 @@ def build_model(
     scene
         The problem.
     elements
-        Target element count over the length (default ``scene.beam_model.elements``).
+        Element count over the length (default ``scene.beam_model.elements``); kept exactly.
     gauss
         Gauss orders (n_η, n_ξ) per layer name; default :data:`~beam_element.quadrature.EXACT_ORDER`
         (exact for the polynomial strain energy).
@@ -231,11 +247,22 @@ def build_model(
         Width s (mm) over which the penalty pressure is regularised
         (:func:`~beam_element.contact.pressure_law`); default ``SMOOTHING_FRACTION`` × the
         penetration bound. 0 gives the plain (kinked) penalty.
+    grading, growth, size_ratio
+        Mesh along x (:func:`~beam_element.mesh.build_mesh`): ``"graded"`` (default) puts the
+        smallest elements at :func:`refinement_centres` and grows them by ``growth`` per element
+        up to ``size_ratio`` × the smallest; ``"uniform"`` keeps one size.
+    face_membrane
+        ``"paper"`` (default): the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"``
+        (option, departs from the paper): the faces' ε_x is its element mean along x (assumed
+        membrane strain; removes membrane locking, see docs/beam_vs_2d.md).
     """
+    if face_membrane not in ("paper", "averaged"):
+        raise ValueError(f"face_membrane must be 'paper' or 'averaged', got {face_membrane!r}")
     options = getattr(scene, "beam_model", None)
     if elements is None:
         elements = getattr(options, "elements", 120)
-    mesh = build_mesh(scene.length, elements, mesh_stations(scene))
+    mesh = build_mesh(scene.length, elements, mesh_stations(scene), centres=refinement_centres(scene),
+                      grading=grading, growth=growth, size_ratio=size_ratio)
     if not (np.isfinite(scene.width) and scene.width > 0):
         raise ValueError(f"beam width must be positive, got {scene.width!r}")
     orders = dict(EXACT_ORDER)
@@ -246,7 +273,8 @@ def build_model(
                  "core": core_stiffness(scene.core.material),
                  "bottom": face_stiffness(scene.bottom.material)}
     thickness = {"top": ht, "core": hc, "bottom": hb}
-    layers = {n: build_layer_operators(n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n])
+    layers = {n: build_layer_operators(n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n],
+                                       membrane_average=(n != "core" and face_membrane == "averaged"))
               for n in LAYERS}
     products = {n: geometric_products(op) for n, op in layers.items()}
 

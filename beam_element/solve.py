@@ -142,6 +142,7 @@ def run(
     progress: Callable[[object], None] | None = None,
     *,
     elements: int | None = None,
+    model_options: dict | None = None,
 ) -> BeamRun:
     """Build the beam model of ``scene``, solve it, and return solution, model and states.
 
@@ -152,13 +153,16 @@ def run(
     progress
         Per-step callback of the path follower (nonlinear analyses).
     elements
-        Target element count (default ``scene.beam_model.elements``).
+        Element count (default ``scene.beam_model.elements``).
+    model_options
+        Further keyword arguments of :func:`~beam_element.model.build_model` (e.g. ``grading``).
     """
     t0 = time.perf_counter()
     a = scene.analysis
     if a.kind not in ("linear", "nonlinear"):
         raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
-    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene))
+    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                        **(model_options or {}))
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []
     if not nonlinear:

@@ -17,8 +17,8 @@ from sandwich.scene import Analysis
 L = 300.0
 
 
-def _w(scene):
-    return run(scene).solution.history[-1].probes
+def _w(scene, **options):
+    return run(scene, model_options=options).solution.history[-1].probes
 
 
 def test_zero_length_debond_equals_bonded():
@@ -32,14 +32,15 @@ def test_zero_length_debond_equals_bonded():
 
 def test_shrinking_debonds_converge_to_bonded():
     # debond centred at x = 100 on the bottom interface (in tension under three-point bending),
-    # mesh of 0.5 mm so that every debond has interior (untied) nodes
+    # uniform mesh of 0.5 mm so that every debond has interior (untied) nodes and the meshes
+    # differ only by the debond's two stations (a graded mesh would refine at each tip)
     probes = (Probe("w_top_mid", "top", 150.0), Probe("w_bottom_100", "bottom", 100.0))
-    bonded = _w(sandwich_scene(elements=600, probes=probes))["w_bottom_100"]
+    bonded = _w(sandwich_scene(elements=600, probes=probes), grading="uniform")["w_bottom_100"]
     diffs = []
     for length in (16.0, 8.0, 4.0, 2.0):
         scene = sandwich_scene(elements=600, probes=probes,
                                debonds=(Debond("bottom", 100 - length / 2, 100 + length / 2),))
-        diffs.append(abs(_w(scene)["w_bottom_100"] - bonded))
+        diffs.append(abs(_w(scene, grading="uniform")["w_bottom_100"] - bonded))
     assert np.all(np.diff(diffs) < 0), diffs
     assert diffs[-1] < diffs[0] / 4
 
@@ -64,7 +65,11 @@ def test_debond_in_pure_compression_behaves_like_bonded_normally():
         bonded_scene = bonded_scene.__class__(**{**bonded_scene.__dict__, "analysis": analysis})
         debonded_scene = debonded_scene.__class__(
             **{**debonded_scene.__dict__, "analysis": analysis})
-        b, d = run(bonded_scene), run(debonded_scene)
+        # uniform mesh: node-to-node contact lumps p over tributary lengths, which on a graded
+        # mesh differs from the consistent (Hermite) load by up to ~2 % node to node (measured)
+        uniform = {"grading": "uniform"}
+        b = run(bonded_scene, model_options=uniform)
+        d = run(debonded_scene, model_options=uniform)
         assert d.solution.converged and b.solution.converged
         col = d.solution.profiles[-1].columns
         inside = (col["x"] > 110) & (col["x"] < 190)
