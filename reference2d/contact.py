@@ -52,9 +52,38 @@ def gap_with_derivatives(xs, x0, x1, x2):
     return g, grad, 0.5 * (hess + hess.T)
 
 
+def gaps_with_derivatives(d: np.ndarray, a: np.ndarray):
+    """Batched :func:`gap_with_derivatives` for n slaves at once.
+
+    ``d`` (n, 2) is x_s − x_0, ``a`` (n, 2) the chord x_2 − x_1. Returns g (n,), the gradient
+    (n, 8) and the Hessian (n, 8, 8) with respect to X = (x_s, x_0, x_1, x_2), the same
+    expressions as the single-slave function (which the finite-difference test checks).
+    """
+    L2 = np.einsum("ni,ni->n", a, a)
+    L = np.sqrt(L2)
+    Ja = a @ J.T
+    Jd = d @ J.T
+    n = Ja / L[:, None]
+    g = np.einsum("ni,ni->n", n, d)
+    g_a = -Jd / L[:, None] - (g / L2)[:, None] * a
+    H_da = J[None] / L[:, None, None] - np.einsum("ni,nj->nij", n, a) / L2[:, None, None]
+    H_aa = (np.einsum("ni,nj->nij", Jd, a) / (L2 * L)[:, None, None]
+            - np.einsum("ni,nj->nij", a, g_a) / L2[:, None, None]
+            - (g / L2)[:, None, None] * np.eye(2)[None]
+            + (2.0 * g / (L2 * L2))[:, None, None] * np.einsum("ni,nj->nij", a, a))
+    grad = np.concatenate([n, -n, -g_a, g_a], axis=1)
+    cross = np.einsum("ia,nij,jb->nab", _D, H_da, _A)
+    hess = cross + cross.transpose(0, 2, 1) + np.einsum("ia,nij,jb->nab", _A, H_aa, _A)
+    return g, grad, 0.5 * (hess + hess.transpose(0, 2, 1))
+
+
 @dataclass
 class ContactPair:
-    """One debond's lips as local DOF blocks plus reference data."""
+    """One debond's lips: node indices (into the arrays handed to :func:`evaluate`) and weights.
+
+    :func:`reference2d.model.contact_pairs` gives input-mesh node indices (the same on every MPI
+    rank); the system renumbers them into its list of contact nodes.
+    """
 
     slave: np.ndarray  # (ns,) face-lip nodes
     anchor: np.ndarray  # (ns,) the coincident core-lip node of each slave
@@ -64,51 +93,67 @@ class ContactPair:
     width: float  # b (mm)
     x_ref: np.ndarray  # (ns,) reference x of the slave nodes (for profiles)
 
+    @property
+    def all_blocks(self) -> np.ndarray:
+        """(ns, 4): the nodes (s, 0, 1, 2) each slave's gap depends on."""
+        return np.column_stack([self.slave, self.anchor, self.chord[:, 0], self.chord[:, 1]])
+
     def blocks(self, i: int) -> np.ndarray:
-        """The four DOF blocks (s, 0, 1, 2) slave i's gap depends on."""
-        return np.array([self.slave[i], self.anchor[i], self.chord[i, 0], self.chord[i, 1]])
+        """The four nodes (s, 0, 1, 2) slave i's gap depends on."""
+        return self.all_blocks[i]
+
+    def renumbered(self, index: dict[int, int]) -> ContactPair:
+        """The same pair with every node n replaced by ``index[n]``."""
+        def m(a):
+            return np.vectorize(lambda k: index[int(k)], otypes=[np.int64])(a)
+        return ContactPair(m(self.slave), m(self.anchor), m(self.chord), self.weight,
+                           self.penalty, self.width, self.x_ref)
 
 
 @dataclass
 class ContactState:
-    """Result of one contact evaluation."""
+    """Result of one contact evaluation (arrays over the active slaves, in slave order)."""
 
     gap: np.ndarray  # (ns,) signed gaps (mm), negative = penetration
     slip: np.ndarray  # (ns,) tangential offset of the slave from its anchor (mm)
     pressure: np.ndarray  # (ns,) p = k ⟨−g⟩ (MPa)
-    rows: list[np.ndarray]  # per active slave: its 4 DOF blocks
-    forces: list[np.ndarray]  # per active slave: (8,) ∂Π/∂X
-    tangents: list[np.ndarray]  # per active slave: (8, 8) ∂²Π/∂X²
+    active: np.ndarray  # (na,) indices of the slaves with g < 0
+    rows: np.ndarray  # (na, 4) their nodes (s, 0, 1, 2)
+    forces: np.ndarray  # (na, 8) ∂Π/∂X
+    tangents: np.ndarray | None  # (na, 8, 8) ∂²Π/∂X² (None unless asked for)
+
+    def nodal_forces(self, n_nodes: int) -> np.ndarray:
+        """The forces summed per node, (n_nodes, 2)."""
+        f = np.zeros((n_nodes, 2))
+        np.add.at(f, self.rows.ravel(), self.forces.reshape(-1, 2))
+        return f
 
 
 def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
              want_tangent: bool = True) -> ContactState:
-    """Gaps, pressures, forces and tangents at reference positions + displacements (blocks, 2).
+    """Gaps, pressures, forces and tangents at reference positions + displacements (nodes, 2).
 
-    The slave–anchor offset x_s − x_0 is formed as (X_s − X_0) + (u_s − u_0): the positions are
-    ~10² mm while the gap is ~10⁻⁵ mm, and X + u first would lose the gap to round-off (which
-    the stiff penalty turns into a residual floor far above Newton's tolerance).
+    Vectorised over the slaves of the pair. The slave–anchor offset x_s − x_0 is formed as
+    (X_s − X_0) + (u_s − u_0): the positions are ~10² mm while the gap is ~10⁻⁵ mm, and X + u
+    first would lose the gap to round-off (which the stiff penalty turns into a residual floor
+    far above Newton's tolerance).
     """
-    ns = len(pair.slave)
-    gaps = np.zeros(ns)
-    slips = np.zeros(ns)
-    rows, forces, tangents = [], [], []
-    for i in range(ns):
-        blocks = pair.blocks(i)
-        d = (x_ref[blocks[0]] - x_ref[blocks[1]]) + (u[blocks[0]] - u[blocks[1]])
-        x1, x2 = x_ref[blocks[2:]] + u[blocks[2:]]
-        g, dg, d2g = gap_with_derivatives(d, np.zeros(2), x1, x2)
-        t = (x2 - x1) / np.linalg.norm(x2 - x1)
-        gaps[i] = g
-        slips[i] = d @ t
-        if g < 0.0:
-            kw = pair.penalty * pair.width * pair.weight[i]
-            rows.append(blocks)
-            forces.append(kw * g * dg)
-            if want_tangent:
-                tangents.append(kw * (np.outer(dg, dg) + g * d2g))
+    s, a0 = pair.slave, pair.anchor
+    c1, c2 = pair.chord[:, 0], pair.chord[:, 1]
+    d = (x_ref[s] - x_ref[a0]) + (u[s] - u[a0])
+    chord = (x_ref[c2] + u[c2]) - (x_ref[c1] + u[c1])
+    L = np.sqrt(np.einsum("ni,ni->n", chord, chord))
+    slips = np.einsum("ni,ni->n", d, chord) / L
+    gaps = np.einsum("ni,ni->n", (chord @ J.T) / L[:, None], d)  # as in gaps_with_derivatives
+    active = np.flatnonzero(gaps < 0.0)
+    g, dg, d2g = gaps_with_derivatives(d[active], chord[active])
+    kw = pair.penalty * pair.width * pair.weight[active]
+    forces = (kw * g)[:, None] * dg
+    tangents = None
+    if want_tangent:
+        tangents = kw[:, None, None] * (np.einsum("na,nb->nab", dg, dg) + g[:, None, None] * d2g)
     pressure = pair.penalty * np.maximum(-gaps, 0.0)
-    return ContactState(gaps, slips, pressure, rows, forces, tangents)
+    return ContactState(gaps, slips, pressure, active, pair.all_blocks[active], forces, tangents)
 
 
 def slave_weights(x_ref: np.ndarray, x_left_tip: float | None,

@@ -8,8 +8,10 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.io import XDMFFile
+from mpi4py import MPI
 
 from reference2d.constitutive import deformation_gradient, green_lagrange
+from reference2d.mesh import allreduce_array
 
 
 def write_fields(solution, path: str | Path, every: int = 1) -> Path:
@@ -84,7 +86,7 @@ def cauchy_cell_values(model, u: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def field_frame(model, step: int, load_factor: float, u: np.ndarray):
-    """A :class:`sandwich.results.FieldFrame` of state ``u`` on the input mesh (serial only).
+    """A :class:`sandwich.results.FieldFrame` of state ``u`` on the input mesh (every rank).
 
     Points are the input mesh's nodes (x, z), each 9-node quad split into 4 counter-clockwise
     sub-quads; point data ``displacement``; cell data (per sub-quad, the parent cell's centre
@@ -95,22 +97,38 @@ def field_frame(model, step: int, load_factor: float, u: np.ndarray):
     from sandwich.results import FieldFrame
 
     msh = model.disc.mesh
-    if msh.comm.size > 1:
-        raise NotImplementedError("field frames are built in serial runs only")
+    comm = msh.comm
     points = np.asarray(model.mesh.points, dtype=float)[:, :2]
     cells9 = np.asarray(model.mesh.cells, dtype=np.int64)
-    blocks = model.disc.blocks(np.arange(len(points)))
-    disp = np.asarray(u).reshape(-1, 2)[blocks]
-    # input cell -> dolfinx cell, matched by the set of input node indices
+    # displacement per input node from the owned DOF blocks of every rank
+    owned = model.system.n_owned // 2
+    to_block = model.disc.node_to_block
+    nodes = np.array([n for n, b in to_block.items() if b < owned], dtype=np.int64)
+    blocks = np.array([to_block[int(n)] for n in nodes], dtype=np.int64)
+    u_loc = np.zeros(model.system.n_local)
+    u_loc[: len(u)] = u
+    disp = np.zeros((len(points), 2))
+    disp[nodes] = u_loc.reshape(-1, 2)[blocks]
+    # input cell -> owned dolfinx cell, matched by the set of input node indices
     inputs = msh.geometry.input_global_indices
     dm = msh.geometry.dofmap
     n = msh.topology.index_map(2).size_local
-    by_nodes = {frozenset(int(inputs[g]) for g in dm.links(c)): c for c in range(n)}
-    order = np.array([by_nodes[frozenset(map(int, c))] for c in cells9])
+    by_nodes = {frozenset(map(int, c)): i for i, c in enumerate(cells9)}
+    mine = np.array([by_nodes[frozenset(int(inputs[g]) for g in dm.links(c))]
+                     for c in range(n)], dtype=np.int64)
     values = cauchy_cell_values(model, u)
     names = [b.name for b in layer_bands(model.scene)]
-    region = np.array([REGION_OF_BAND[names[k]] for k in model.stiffness.layer_index[:n]])
+    region_local = np.array([REGION_OF_BAND[names[k]] for k in model.stiffness.layer_index[:n]])
+    per_cell = {k: np.zeros(len(cells9)) for k in values}
+    region = np.zeros(len(cells9))
+    for k, v in values.items():
+        per_cell[k][mine] = v
+    region[mine] = region_local
+    if comm.size > 1:  # every node / cell is owned by exactly one rank: sums are gathers
+        disp = allreduce_array(comm, disp, MPI.SUM)
+        per_cell = {k: allreduce_array(comm, v, MPI.SUM) for k, v in per_cell.items()}
+        region = allreduce_array(comm, region, MPI.SUM)
     sub = cells9[:, QUAD9_SUBQUADS].reshape(-1, 4)
-    cell_data = {k: np.repeat(v[order], 4) for k, v in values.items()}
-    cell_data["region"] = np.repeat(region[order], 4).astype(np.int32)
+    cell_data = {k: np.repeat(v, 4) for k, v in per_cell.items()}
+    cell_data["region"] = np.repeat(region, 4).astype(np.int32)
     return FieldFrame(int(step), float(load_factor), points, sub, disp, {}, cell_data)

@@ -57,15 +57,27 @@ def build_discretisation(points: np.ndarray, cells: np.ndarray,
         c = np.zeros((0, NODES_PER_CELL), dtype=np.int64)
     msh = create_mesh(comm, c, x, quad9_domain())
     V = fem.VectorFunctionSpace(msh, ("Lagrange", 2))
-    # The coordinate element and V are both Lagrange Q2, so the local node order of a cell is the
-    # same in the geometry dofmap and in V's dofmap: geometry node -> DOF block, cell by cell.
+    return Discretisation(msh, V, input_node_blocks(V))
+
+
+def input_node_blocks(V) -> dict[int, int]:
+    """Input node index -> local DOF block of V, for every node of this rank's cells (ghosts too).
+
+    The coordinate element and V are both Lagrange Q2, so the local node order of a cell is the
+    same in the geometry dofmap and in V's dofmap: geometry node -> DOF block, cell by cell.
+    """
+    msh = V.mesh
     x_dofmap = msh.geometry.dofmap
     inputs = msh.geometry.input_global_indices
-    node_to_block: dict[int, int] = {}
     n_cells = msh.topology.index_map(2).size_local + msh.topology.index_map(2).num_ghosts
-    for cell in range(n_cells):
-        geo = x_dofmap.links(cell)
-        dofs = V.dofmap.cell_dofs(cell)
-        for g, d in zip(geo, dofs, strict=True):
-            node_to_block[int(inputs[g])] = int(d)
-    return Discretisation(msh, V, node_to_block)
+    geo = np.array([x_dofmap.links(c) for c in range(n_cells)]).ravel()
+    dofs = np.array([V.dofmap.cell_dofs(c) for c in range(n_cells)]).ravel()
+    return dict(zip(np.asarray(inputs)[geo].tolist(), dofs.tolist(), strict=True))
+
+
+def allreduce_array(comm, a: np.ndarray, op) -> np.ndarray:
+    """Element-wise MPI reduction of a numpy array (a new array, same shape and dtype)."""
+    a = np.ascontiguousarray(a)
+    out = np.empty_like(a)
+    comm.Allreduce(a, out, op=op)
+    return out

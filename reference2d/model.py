@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import fem, geometry
+from mpi4py import MPI
+from petsc4py import PETSc
 
 from reference2d import contact as ct
 from reference2d.constitutive import LayerBand, PlaneStressStiffness, internal_work
@@ -94,8 +96,9 @@ def build_model(scene: Scene, mesh, penalty: float | None = None) -> Model2D:
     stiffness = PlaneStressStiffness(disc.mesh, bands)
     n_local = (V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts) * 2
     X = V.tabulate_dof_coordinates()[:, :2]
-    bc = support_dofs(scene, X)
-    f_ref = load_vector(scene, V, X, n_local)
+    n_owned = V.dofmap.index_map.size_local
+    bc = support_dofs(scene, X, comm=V.mesh.comm)
+    f_ref = load_vector(scene, V, X, n_local, n_owned=n_owned)
     probes = {p.name: probe_vector(V, p.x, face_band(scene, p.on), n_local)
               for p in scene.probes}
     k = penalty if penalty is not None else (scene.reference2d.contact_penalty
@@ -106,8 +109,16 @@ def build_model(scene: Scene, mesh, penalty: float | None = None) -> Model2D:
     return Model2D(scene, mesh, disc, stiffness, system, pairs, ifaces, k)
 
 
-def support_dofs(scene: Scene, X: np.ndarray) -> np.ndarray:
-    """Unrolled local DOF indices fixed by the scene's supports (u: 2 i, w: 2 i + 1)."""
+def support_dofs(scene: Scene, X: np.ndarray, comm=None) -> np.ndarray:
+    """Unrolled local DOF indices fixed by the scene's supports (u: 2 i, w: 2 i + 1).
+
+    ``X`` holds the coordinates of this rank's DOF blocks (owned and ghost). Under MPI a support
+    section may lie partly or wholly on other ranks: the "no node there" check and the pin's
+    mid-surface node are decided over all ranks (``comm``).
+    """
+    def global_min(v: float) -> float:
+        return v if comm is None or comm.size == 1 else comm.allreduce(v, op=MPI.MIN)
+
     fixed: list[np.ndarray] = []
     for s in scene.supports:
         for face in s.faces:
@@ -115,19 +126,28 @@ def support_dofs(scene: Scene, X: np.ndarray) -> np.ndarray:
             section = np.where((np.abs(X[:, 0] - s.x) < GEOM_TOL)
                                & (X[:, 1] > band.z_lo - GEOM_TOL)
                                & (X[:, 1] < band.z_hi + GEOM_TOL))[0]
-            if len(section) == 0:
+            if global_min(0.0 if len(section) else 1.0) > 0.0:
                 raise ValueError(f"support at x = {s.x} on the {face} face: no mesh node there")
             fixed.append(2 * section + 1)  # w on the whole section
             if s.type == "clamp":
                 fixed.append(2 * section)
             elif s.type == "pin":
                 z_mid = 0.5 * (band.z_lo + band.z_hi)
-                fixed.append(2 * section[[np.argmin(np.abs(X[section, 1] - z_mid))]])
+                dz = np.abs(X[section, 1] - z_mid)
+                best = global_min(float(dz.min()) if len(section) else np.inf)
+                fixed.append(2 * section[dz <= best])
     return np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, dtype=np.int64)
 
 
-def load_vector(scene: Scene, V, X: np.ndarray, n_local: int) -> np.ndarray:
-    """Reference load (λ = 1) of every scene load, on the local DOFs."""
+def load_vector(scene: Scene, V, X: np.ndarray, n_local: int,
+                n_owned: int | None = None) -> np.ndarray:
+    """Reference load (λ = 1) of every scene load, on the local DOFs.
+
+    A point load goes to the outer-edge node nearest to x over all ranks, added by the rank that
+    owns it (blocks below ``n_owned``), so that it is counted once.
+    """
+    comm = V.mesh.comm
+    n_owned_blocks = len(X) if n_owned is None else n_owned
     f = np.zeros(n_local)
     for ld in scene.loads:
         z = outer_z(scene, ld.on)
@@ -145,29 +165,52 @@ def load_vector(scene: Scene, V, X: np.ndarray, n_local: int) -> np.ndarray:
             t_z = ld.force / (length * scene.width)  # MPa, total force exactly ld.force
             f += edge_load_vector(V, facets, (0.0, t_z), scene.width, n_local)
         else:
-            edge = np.where(np.abs(X[:, 1] - z) < GEOM_TOL)[0]
-            node = edge[np.argmin(np.abs(X[edge, 0] - ld.x))]
-            f[2 * node + 1] += ld.force
+            own = X[:n_owned_blocks]
+            edge = np.where(np.abs(own[:, 1] - z) < GEOM_TOL)[0]
+            dist = float(np.min(np.abs(own[edge, 0] - ld.x))) if len(edge) else np.inf
+            # the nearest over all ranks; ties go to the lowest rank
+            best, rank = comm.allreduce((dist, comm.rank), op=MPI.MIN)
+            if not np.isfinite(best):
+                raise ValueError(f"point load at x = {ld.x} on the {ld.on} face: no edge node")
+            if rank == comm.rank:
+                node = edge[np.argmin(np.abs(own[edge, 0] - ld.x))]
+                f[2 * node + 1] += ld.force
     return f
 
 
 def probe_vector(V, x: float, band: LayerBand, n_local: int) -> np.ndarray:
-    """C with c · u = w(x, z_mid) of the face ``band`` (Q2 interpolation in its cell)."""
+    """C with c · u = w(x, z_mid) of the face ``band`` (Q2 interpolation in its cell).
+
+    Under MPI the point may be found on several ranks (ghost cells, or a point on a partition
+    boundary): the lowest rank that finds it builds c, which is then summed onto the DOFs' owners
+    (ghost entries of the result are zero), so that c · u summed over ranks counts it once.
+    """
     msh = V.mesh
+    comm = msh.comm
     z_mid = 0.5 * (band.z_lo + band.z_hi)
     point = np.array([[x, z_mid, 0.0]])
     tree = geometry.BoundingBoxTree(msh, msh.topology.dim)
     cells = geometry.compute_colliding_cells(msh, geometry.compute_collisions(tree, point), point)
+    found = len(cells.links(0)) > 0
     c = np.zeros(n_local)
-    if len(cells.links(0)) == 0:
-        return c  # the point lives on another rank
-    cell = cells.links(0)[0]
+    winner = comm.allreduce(comm.rank if found else comm.size, op=MPI.MIN)
+    if winner == comm.size:
+        raise ValueError(f"probe point ({x}, {z_mid}) lies outside the mesh")
     e = fem.Function(V)
-    for blk in V.dofmap.cell_dofs(cell):
-        e.x.array[:] = 0.0
-        e.x.array[2 * blk + 1] = 1.0
-        c[2 * blk + 1] = e.eval(point, [cell])[1]
-    return c
+    if comm.rank == winner:
+        cell = cells.links(0)[0]
+        for blk in V.dofmap.cell_dofs(cell):
+            e.x.array[:] = 0.0
+            e.x.array[2 * blk + 1] = 1.0
+            c[2 * blk + 1] = e.eval(point, [cell])[1]
+    if comm.size == 1:
+        return c
+    e.x.array[:] = c
+    e.vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    n_owned = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+    out = np.zeros(n_local)
+    out[:n_owned] = e.vector.array[:n_owned]
+    return out
 
 
 def contact_pairs(scene: Scene, mesh, disc: Discretisation,
@@ -195,11 +238,12 @@ def contact_pairs(scene: Scene, mesh, disc: Discretisation,
             [tips[1]] if tips[1] is not None else [])
         if debond.interface == "bottom":
             chain = chain[::-1]  # so that n = J (x2 − x1)/|…| points out of the core (−z)
-        master = disc.blocks(np.array(chain))
-        slave = disc.blocks(face_nodes)
+        # input node indices (the same on every rank; the system finds their DOFs)
+        master = np.array(chain, dtype=np.int64)
+        slave = np.asarray(face_nodes, dtype=np.int64)
         position = {int(blk): k for k, blk in enumerate(master)}
-        anchor = disc.blocks(core_nodes)
-        chord = np.zeros((len(slave), 2), dtype=np.int32)
+        anchor = np.asarray(core_nodes, dtype=np.int64)
+        chord = np.zeros((len(slave), 2), dtype=np.int64)
         for j, blk in enumerate(anchor):
             k = position[int(blk)]
             chord[j] = (master[max(k - 1, 0)], master[min(k + 1, len(master) - 1)])

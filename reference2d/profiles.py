@@ -11,8 +11,10 @@ from __future__ import annotations
 import numpy as np
 import ufl
 from dolfinx import fem, geometry
+from mpi4py import MPI
 
 from reference2d.constitutive import green_lagrange
+from reference2d.mesh import allreduce_array
 from reference2d.model import Model2D, face_band
 
 GEOM_TOL = 1e-7
@@ -44,7 +46,18 @@ class ProfileSampler:
             "sigma_zz_top": (0.5 * hc, self.core), "sigma_zz_bottom": (-0.5 * hc, self.core),
             "tau_core": (0.0, self.core),
         }
+        self.n_owned_cells = msh.topology.index_map(2).size_local
+        self.input_cell = np.asarray(msh.topology.original_cell_index, dtype=np.int64)
         self.cells = {k: self._cells(z, layer) for k, (z, layer) in self.rows.items()}
+        # under MPI a station on a partition boundary is found on two ranks: the rank holding
+        # the lowest input cell samples it (the same cell as in a serial run)
+        comm = msh.comm
+        big = np.iinfo(np.int64).max
+        self.mine = {}
+        for k, cells in self.cells.items():
+            idx = np.where(cells >= 0, self.input_cell[np.maximum(cells, 0)], big)
+            best = allreduce_array(comm, idx, MPI.MIN) if comm.size > 1 else idx
+            self.mine[k] = (cells >= 0) & (idx == best)
 
     def _cells(self, z: float, layer: int | None) -> np.ndarray:
         msh = self.model.disc.mesh
@@ -53,10 +66,11 @@ class ProfileSampler:
         out = np.full(len(self.x), -1, dtype=np.int32)
         for i in range(len(self.x)):
             cand = coll.links(i)
+            cand = [c for c in cand if c < self.n_owned_cells]  # owned cells (MPI)
             if layer is not None:
                 cand = [c for c in cand if self.model.stiffness.layer_index[c] == layer]
-            if len(cand):
-                out[i] = cand[0]
+            if len(cand):  # S is discontinuous: the lowest input cell, whatever the partition
+                out[i] = min(cand, key=lambda c: self.input_cell[c])
         return out
 
     def sample(self, u: np.ndarray) -> dict[str, np.ndarray]:
@@ -68,14 +82,15 @@ class ProfileSampler:
         for name, (z, _layer) in self.rows.items():
             p = np.column_stack([self.x, np.full_like(self.x, z), np.zeros_like(self.x)])
             cells = self.cells[name]
-            ok = cells >= 0
+            ok = self.mine[name]
             vals = np.zeros(len(self.x))
             if name.startswith("w_"):
                 vals[ok] = system.u.eval(p[ok], cells[ok])[:, 1]
             else:
                 comp = {"sigma_zz_top": 1, "sigma_zz_bottom": 1, "tau_core": 2}[name]
                 vals[ok] = self.S.eval(p[ok], cells[ok])[:, comp]
-            cols[name] = vals
+            comm = self.model.disc.mesh.comm
+            cols[name] = allreduce_array(comm, vals, MPI.SUM) if comm.size > 1 else vals
         for iface in ("top", "bottom"):
             p_c = np.zeros(len(self.x))
             for pair, state, where in zip(self.model.contact_pairs, system.last_contact,

@@ -44,7 +44,14 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     """
     t0 = time.perf_counter()
     if mesh is None:
-        mesh = build_scene_mesh(scene, level, refine)
+        from mpi4py import MPI
+
+        comm = MPI.COMM_WORLD
+        if comm.size == 1:
+            mesh = build_scene_mesh(scene, level, refine)
+        else:  # gmsh on rank 0 only; every rank needs the arrays (lips, profile stations)
+            mesh = comm.bcast(build_scene_mesh(scene, level, refine) if comm.rank == 0 else None,
+                              root=0)
     model = build_model(scene, mesh, penalty=penalty)
     system = model.system
     names = [p.name for p in scene.probes]
@@ -75,7 +82,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
             u = lf * u1
             system.commit(u, lf)
             record(PathState(step, u, lf, 0 if step == 0 else 1,
-                             {n: float(system.probe_vector(n) @ u) for n in names}, None))
+                             {n: system.dot(system.probe_vector(n), u) for n in names}, None))
         converged, message = True, f"linear solution scaled to λ = {lam:.6g}"
     else:
         # Newton cannot get the residual below the round-off of its own evaluation: ask for the
@@ -103,13 +110,14 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
             penetration / min(scene.top.thickness, scene.bottom.thickness)),
         "newton_iterations": int(sum(r.iterations for r in rows)),
         "stress_measure": "second Piola-Kirchhoff, reference frame",
+        "mpi_ranks": int(model.disc.mesh.comm.size),
     }
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)
     solution = Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
-                        limit_points, time.perf_counter() - t0, int(system.size), extra)
-    if states and model.disc.mesh.comm.size == 1:  # the last state for ParaView (VTU + PVD)
+                        limit_points, time.perf_counter() - t0, int(system.global_size), extra)
+    if states:  # the last state for ParaView (VTU + PVD), gathered to every rank
         from reference2d.fields import field_frame
 
         step, lf, u_last = states[-1]
@@ -125,7 +133,7 @@ def _linear_target(scene: Scene, system, u1: np.ndarray) -> float:
     if a.until_load_factor is not None:
         return float(a.until_load_factor)
     if a.until_probe is not None:
-        w1 = float(system.probe_vector(a.until_probe) @ u1)
+        w1 = system.dot(system.probe_vector(a.until_probe), u1)
         if w1 == 0.0:
             raise ValueError(f"probe {a.until_probe!r} does not move under the load")
         return float(a.until_value) / w1

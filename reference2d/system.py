@@ -5,18 +5,25 @@ block order). Supports are homogeneous and imposed as trivial equations u_i = 0 
 of the tangent replaced by the identity), so the constrained DOFs stay zero along any path and
 the solver's vectors need no index juggling. Contact terms are evaluated in NumPy and added to the
 PETSc matrix, whose sparsity pattern holds every potential contact block from the start.
-Serial: numpy vectors are the rank's owned DOFs (all of them on one rank).
+
+MPI: numpy vectors are the rank's owned DOFs. The two lips of a debond share no cell, so a
+slave's anchor and chord nodes are often on another rank: the displacements of all contact nodes
+(a few hundred) are gathered to every rank, every rank evaluates all the contact, and each adds
+only the rows it owns. The matrix is created here (not by dolfinx) from the form's sparsity
+pattern plus the contact couplings in global numbering, so off-rank contact columns have slots.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import ufl
-from dolfinx import cpp, fem
+from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from reference2d import contact as ct
+from reference2d.mesh import allreduce_array, input_node_blocks
 
 JIT = {"cffi_extra_compile_args": ["-O2"]}
 
@@ -149,6 +156,7 @@ class Reference2DSystem:
         self._f_ref[self.bc_dofs[self.bc_dofs < self.n_owned]] = 0.0
         self.probes = probes
         self.x_ref = V.tabulate_dof_coordinates()[:, :2].copy()  # per block
+        self._setup_contact_nodes()
         self.A = self._create_matrix()
         self.b = fem_petsc.create_vector(self.R_form)
         self.last_contact: list[ct.ContactState] = []
@@ -166,6 +174,11 @@ class Reference2DSystem:
         return self.n_owned
 
     @property
+    def global_size(self) -> int:
+        """Number of unknowns over all ranks."""
+        return self.V.dofmap.index_map.size_global * self.bs
+
+    @property
     def f_ref(self) -> np.ndarray:
         """Reference load (λ = 1)."""
         return self._f_ref[: self.n_owned]
@@ -175,10 +188,13 @@ class Reference2DSystem:
         self._set_u(u)
         with self.b.localForm() as b_local:
             b_local.set(0.0)
-            for state, _pair in self._contact_states(want_tangent=False):
-                for rows, f in zip(state.rows, state.forces, strict=True):
-                    dofs = (self.bs * rows[:, None] + np.arange(self.bs)).ravel()
-                    np.add.at(b_local.array, dofs, f)
+            states = self._contact_states(want_tangent=False)
+            if states:
+                f = np.zeros((self._nc, 2))
+                for state, _pair in states:
+                    f += state.nodal_forces(self._nc)
+                # owned contact nodes only (ghost entries would be summed twice)
+                b_local.array.reshape(-1, self.bs)[self._c_own_blk] += f[self._c_own]
         fem_petsc.assemble_vector(self.b, self.R_form)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         r = self.b.array.copy()
@@ -195,16 +211,17 @@ class Reference2DSystem:
         fem_petsc.assemble_matrix(A, self.J_form)
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
-        # PETSc drops pattern slots that stay unfilled at a final assembly: touch every
-        # potential contact block with zeros, then add the active ones
-        for blocks in self._contact_blocks:
-            dofs = (self.bs * blocks[:, None] + np.arange(self.bs)).ravel().astype(np.int32)
-            A.setValuesLocal(dofs, dofs, np.zeros((len(dofs), len(dofs))),
-                             addv=PETSc.InsertMode.ADD_VALUES)
-        for state, _pair in self._contact_states(want_tangent=True):
-            for rows, k in zip(state.rows, state.tangents, strict=True):
-                dofs = (self.bs * rows[:, None] + np.arange(self.bs)).ravel().astype(np.int32)
-                A.setValuesLocal(dofs, dofs, k, addv=PETSc.InsertMode.ADD_VALUES)
+        if self._c_nnz:
+            # every contact slot of the pattern (zeros where open), summed over the active
+            # slaves' 8×8 blocks with one bincount, inserted row by row (owned rows only)
+            data = np.zeros(self._c_nnz)
+            for state, pair in self._contact_states(want_tangent=True):
+                slots = self._c_slots[id(pair)][state.active]
+                data += np.bincount(slots.ravel(), weights=state.tangents.ravel(),
+                                    minlength=self._c_nnz)
+            add = PETSc.InsertMode.ADD_VALUES
+            for row, lo, hi in self._c_rows:
+                A.setValues(row, self._c_cols[lo:hi], data[lo:hi], addv=add)
         A.assemble()
         own_bc = self.bc_dofs[self.bc_dofs < self.n_owned]
         glob = (self.V.dofmap.index_map.local_range[0] * self.bs + own_bc).astype(np.int32)
@@ -245,22 +262,110 @@ class Reference2DSystem:
         """X = X + u for every local DOF block, (blocks, 2)."""
         return self.x_ref + self.u.x.array.reshape(-1, self.bs)
 
+    def _setup_contact_nodes(self) -> None:
+        """The contact nodes (input indices) as a compact list: global DOF blocks, reference
+        positions (the same on every rank), owned local blocks, and the tangent's slot map."""
+        im = self.V.dofmap.index_map
+        pairs = self.contacts
+        nodes = (np.unique(np.concatenate([p.all_blocks.ravel() for p in pairs]))
+                 if pairs else np.zeros(0, dtype=np.int64))
+        self._nc = nc = len(nodes)
+        index = {int(n): k for k, n in enumerate(nodes)}
+        self._compact = {id(p): p.renumbered(index) for p in pairs}
+        to_block = input_node_blocks(self.V) if nc else {}
+        local = np.array([to_block.get(int(n), -1) for n in nodes], dtype=np.int64)
+        owned = (local >= 0) & (local < im.size_local)
+        self._c_own = np.flatnonzero(owned)
+        self._c_own_blk = local[owned]
+        gblock = np.full(nc, -1, dtype=np.int64)
+        gblock[owned] = im.local_range[0] + local[owned]
+        xref = np.zeros((nc, 2))
+        xref[owned] = self.x_ref[local[owned]]
+        if self.comm.size > 1:
+            gblock = allreduce_array(self.comm, gblock, MPI.MAX)
+            xref = allreduce_array(self.comm, xref, MPI.SUM)
+        if np.any(gblock < 0):
+            raise ValueError("a contact node is owned by no rank")
+        self._c_gblock, self._c_xref = gblock, xref
+        # the contact part of the pattern in compact DOFs (2 node + component): for each pair
+        # the slot of every entry of every slave's 8×8 block in one sorted list of (row, col)
+        keys, sizes = [], []
+        for p in pairs:
+            dofs = (2 * self._compact[id(p)].all_blocks[:, :, None] + np.arange(2)).reshape(-1, 8)
+            keys.append((dofs[:, :, None] * (2 * nc) + dofs[:, None, :]).ravel())
+            sizes.append(len(dofs))
+        uniq, inverse = (np.unique(np.concatenate(keys), return_inverse=True) if keys
+                         else (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
+        self._c_nnz = len(uniq)
+        self._c_slots, start = {}, 0
+        for p, n in zip(pairs, sizes, strict=True):
+            self._c_slots[id(p)] = inverse[start: start + 64 * n].reshape(n, 8, 8)
+            start += 64 * n
+        rows, cols = uniq // (2 * nc) if nc else uniq, uniq % (2 * nc) if nc else uniq
+        self._c_pattern_nodes = (rows // 2, cols // 2)  # compact node pairs, for the matrix
+        self._c_cols = (2 * gblock[cols // 2] + cols % 2).astype(np.int32)  # global columns
+        bounds = np.flatnonzero(np.diff(rows, prepend=-1, append=-1))
+        self._c_rows = [(int(2 * gblock[rows[lo] // 2] + rows[lo] % 2), int(lo), int(hi))
+                        for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
+                        if owned[rows[lo] // 2]]
+
     def _contact_states(self, want_tangent: bool):
+        """[(state, pair)] of every pair, from the contact-node displacements of all ranks."""
         if not self.contacts:
             return []
         u = self.u.x.array.reshape(-1, self.bs)
-        return [(ct.evaluate(p, self.x_ref, u, want_tangent), p) for p in self.contacts]
+        uc = np.zeros((self._nc, 2))
+        uc[self._c_own] = u[self._c_own_blk]
+        if self.comm.size > 1:
+            uc = allreduce_array(self.comm, uc, MPI.SUM)
+        return [(ct.evaluate(self._compact[id(p)], self._c_xref, uc, want_tangent), p)
+                for p in self.contacts]
 
     def _create_matrix(self) -> PETSc.Mat:
+        """AIJ matrix (block size 2) with the form's pattern plus every contact coupling.
+
+        Built from global indices so that contact columns owned by other ranks get slots;
+        the local-to-global map is V's (owned + ghost blocks), as dolfinx's assembler needs.
+        Preallocation by CSR inserts explicit zeros in every slot, so no slot is ever dropped.
+        """
+        im = self.V.dofmap.index_map
+        bs = self.bs
         sp = fem.create_sparsity_pattern(self.J_form)
-        self._contact_blocks = []
-        for pair in self.contacts:
-            for i in range(len(pair.slave)):
-                blocks = pair.blocks(i).astype(np.int32)
-                sp.insert(blocks, blocks)
-                self._contact_blocks.append(blocks)
         sp.assemble()
-        A = cpp.la.petsc.create_matrix(self.comm, sp)
+        graph = sp.graph
+        cmap = sp.column_index_map()
+        n_rows = im.size_local
+        offsets = np.asarray(graph.offsets)
+        rows = np.repeat(np.arange(n_rows, dtype=np.int64), np.diff(offsets)[:n_rows])
+        cols = np.asarray(cmap.local_to_global(
+            np.asarray(graph.array[: offsets[n_rows]], dtype=np.int32)), dtype=np.int64)
+        r_node, c_node = self._c_pattern_nodes
+        if len(r_node):
+            own_local = np.full(self._nc, -1, dtype=np.int64)
+            own_local[self._c_own] = self._c_own_blk
+            keep = own_local[r_node] >= 0
+            rows = np.concatenate([rows, own_local[r_node[keep]]])
+            cols = np.concatenate([cols, self._c_gblock[c_node[keep]]])
+        n_glob = im.size_global
+        key = np.unique(rows * n_glob + cols)
+        brow, bcol = key // n_glob, key % n_glob
+        counts = np.bincount(brow, minlength=n_rows)
+        bptr = np.concatenate([[0], np.cumsum(counts)])
+        # scalar CSR: block row r gives rows bs r + c, each with columns bs c' + d of its blocks
+        scol = (bs * bcol[:, None] + np.arange(bs)).ravel()
+        indptr = np.concatenate([[0], np.cumsum(np.repeat(bs * counts, bs))]).astype(np.int32)
+        indices = np.concatenate(
+            [scol[bs * bptr[r]: bs * bptr[r + 1]] for r in range(n_rows) for _ in range(bs)]
+        ).astype(np.int32) if n_rows else np.zeros(0, dtype=np.int32)
+        n = n_rows * bs
+        A = PETSc.Mat().create(self.comm)
+        A.setSizes(((n, n_glob * bs), (n, n_glob * bs)), bsize=bs)
+        A.setType(PETSc.Mat.Type.AIJ)
+        A.setPreallocationCSR((indptr, indices))
+        glob = im.local_to_global(np.arange(im.size_local + im.num_ghosts, dtype=np.int32))
+        lgmap = PETSc.LGMap().create(np.asarray(glob, dtype=np.int32), bsize=bs, comm=self.comm)
+        A.setLGMap(lgmap, lgmap)
+        A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
         A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return A
 
