@@ -3,8 +3,9 @@
 Runs the fig4 and fig5 paper scenes (path shortened to w_top_mid = UNTIL mm unless --full) and
 times where the work goes: residual assembly, tangent assembly (incl. contact), MUMPS
 factorisation (numeric only after the first: the symbolic analysis is reused), contact
-evaluation. Serial only (see docs/reference2d.md on MPI). Writes
-benchmarks/results/reference2d/speed.{md,json}.
+evaluation (wall times of rank 0). Runs under mpirun too (`mpirun -n 2 ... --out speed_2ranks`):
+timings are then rank 0's, files written by rank 0.
+Writes benchmarks/results/reference2d/<out>.{md,json}.
 
     XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/reference2d_speed.py [--levels coarse medium]
 """
@@ -17,6 +18,8 @@ import json
 import sys
 import time
 from pathlib import Path
+
+from mpi4py import MPI
 
 from reference2d import contact as ct
 from reference2d import model as model_mod
@@ -74,7 +77,7 @@ def run(name, level, full, until=UNTIL):
         ct.evaluate = evaluate
     steps = len(sol.history) - 1
     return {
-        "scene": name, "level": level, "ranks": 1, "dofs": sol.dofs,
+        "scene": name, "level": level, "ranks": MPI.COMM_WORLD.size, "dofs": sol.dofs,
         "cells": sol.extra["cells"], "steps": steps,
         "newton_iterations": sol.extra["newton_iterations"],
         "reached": sol.converged, "final_load_factor": sol.final_load_factor,
@@ -95,13 +98,18 @@ def main():
     for name in SCENES:
         for level in args.levels:
             r = run(name, level, args.full, args.until)
-            print(r, flush=True)
+            if MPI.COMM_WORLD.rank == 0:
+                print(r, flush=True)
             rows.append(r)
+    if MPI.COMM_WORLD.rank != 0:
+        return
     OUT.mkdir(parents=True, exist_ok=True)
     (OUT / f"{args.out}.json").write_text(json.dumps(rows, indent=2) + "\n")
     head = ("| scene | level | ranks | DOFs | steps | Newton its | s/step | residual s | "
             "tangent s | factorise s | contact s | total s |")
-    lines = [f"Path to w_top_mid = {'target' if args.full else args.until} mm, serial.", "", head,
+    ranks = rows[0]["ranks"] if rows else 1
+    lines = [f"Path to w_top_mid = {'target' if args.full else args.until} mm, {ranks} rank(s).",
+             "", head,
              "|" + "---|" * 12]
     for r in rows:
         lines.append(f"| {r['scene']} | {r['level']} | {r['ranks']} | {r['dofs']} | {r['steps']} "

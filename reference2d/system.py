@@ -263,8 +263,11 @@ class Reference2DSystem:
         return self.x_ref + self.u.x.array.reshape(-1, self.bs)
 
     def _setup_contact_nodes(self) -> None:
-        """The contact nodes (input indices) as a compact list: global DOF blocks, reference
-        positions (the same on every rank), owned local blocks, and the tangent's slot map."""
+        """The contact nodes (input indices) as a compact list, the same on every rank.
+
+        Their global DOF blocks and reference positions, the owned ones' local blocks, and the
+        tangent's slot map (each entry of each slave's 8×8 block -> slot of the contact CSR).
+        """
         im = self.V.dofmap.index_map
         pairs = self.contacts
         nodes = (np.unique(np.concatenate([p.all_blocks.ravel() for p in pairs]))
