@@ -161,8 +161,10 @@ def run(
     a = scene.analysis
     if a.kind not in ("linear", "nonlinear"):
         raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
-    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
-                        **(model_options or {}))
+    bm = scene.beam_model
+    options = {"grading": getattr(bm, "grading", "graded"),
+               "face_membrane": getattr(bm, "face_membrane", "paper"), **(model_options or {})}
+    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []
     if not nonlinear:

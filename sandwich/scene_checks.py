@@ -400,12 +400,17 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     key = "beam_model"
-    t = r.table(tbl, key, ("elements", "gauss_x", "gauss_z", "contact_penalty", "profile_every"))
+    t = r.table(tbl, key, ("elements", "grading", "face_membrane", "gauss_x", "gauss_z",
+                           "contact_penalty", "profile_every"))
     if t is None:
         return BeamModelOptions()
     d = BeamModelOptions()
     return BeamModelOptions(
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
+        grading=r.choice(t, "grading", key, ("graded", "uniform"), default=d.grading)
+        or d.grading,
+        face_membrane=r.choice(t, "face_membrane", key, ("paper", "averaged"),
+                               default=d.face_membrane) or d.face_membrane,
         gauss_x=r.integer(t, "gauss_x", key, default=None, lo=2, hi=12),
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
