@@ -30,11 +30,13 @@ def gradients(op: LayerOperators, u_ref: np.ndarray, lengths: np.ndarray) -> Gra
     """Displacement gradients of eq. (15): N,x u_e, N,z u_e, M,x u_e, M,z u_e."""
     dx = (2.0 / np.asarray(lengths, dtype=float))[:, None]
     dz = 2.0 / op.thickness
+    G = op.eta.size
+    d = u_ref @ op.reference_rows.T  # (E, 4G): N,η u  N,ξ u  M,η u  M,ξ u in one GEMM
     return Gradients(
-        u_x=dx * (u_ref @ op.N_eta.T),
-        u_z=dz * (u_ref @ op.N_xi.T),
-        w_x=dx * (u_ref @ op.M_eta.T),
-        w_z=dz * (u_ref @ op.M_xi.T),
+        u_x=dx * d[:, :G],
+        u_z=dz * d[:, G:2 * G],
+        w_x=dx * d[:, 2 * G:3 * G],
+        w_z=dz * d[:, 3 * G:],
         dx=dx,
         dz=dz,
     )
@@ -77,3 +79,30 @@ def strain_variations(
     N_hat = d["M_z"] * (1 + wz) + d["N_z"] * uz  # eq. (17)
     N_tilde = d["N_z"] * (1 + ux) + d["M_x"] * (1 + wz) + d["N_x"] * uz + d["M_z"] * wx  # eq. (17)
     return N_bar, N_hat, N_tilde
+
+
+def strain_rows(op: LayerOperators, g: Gradients) -> np.ndarray:
+    """The rows of :func:`strain_variations` stacked, shape ``(E, G, 3, n)``, by one batched GEMM.
+
+    Each row of eq. (17) is a pointwise combination of the reference rows
+    R = (N,η, N,ξ, M,η, M,ξ): B(e, g) = Φ(e, g) R(g) with Φ of shape (3, 4).
+    """
+    return strain_coefficients(g) @ op.reference_rows_by_point
+
+
+def strain_coefficients(g: Gradients) -> np.ndarray:
+    """Φ of :func:`strain_rows`, shape ``(E, G, 3, 4)``: B(e, g) = Φ(e, g) R(g)."""
+    E, G = g.u_x.shape
+    dx = np.broadcast_to(g.dx, (E, G))
+    dz = g.dz
+    ux, uz, wx, wz = g.u_x, g.u_z, g.w_x, g.w_z
+    Φ = np.zeros((E, G, 3, 4))
+    Φ[..., 0, 0] = dx * (1 + ux)  # N̄ = N,x (1 + u,x) + M,x w,x
+    Φ[..., 0, 2] = dx * wx
+    Φ[..., 1, 3] = dz * (1 + wz)  # N̂ = M,z (1 + w,z) + N,z u,z
+    Φ[..., 1, 1] = dz * uz
+    Φ[..., 2, 0] = dx * uz  # Ñ = N,z (1 + u,x) + M,x (1 + w,z) + N,x u,z + M,z w,x
+    Φ[..., 2, 1] = dz * (1 + ux)
+    Φ[..., 2, 2] = dx * (1 + wz)
+    Φ[..., 2, 3] = dz * wx
+    return Φ

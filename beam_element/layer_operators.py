@@ -16,6 +16,7 @@ the same for every element, so the h/2 of z-slope DOFs is folded into the rows h
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -77,6 +78,41 @@ class LayerOperators:
         return build_layer_operators(
             self.name, self.thickness, self.z_bottom, self.stiffness, eta=eta, xi=xi
         )
+
+    @cached_property
+    def reference_rows(self) -> np.ndarray:
+        """``[N,η; N,ξ; M,η; M,ξ]`` stacked, shape ``(4G, n)`` (computed once per layer)."""
+        return np.concatenate([self.N_eta, self.N_xi, self.M_eta, self.M_xi])
+
+    @cached_property
+    def reference_rows_by_point(self) -> np.ndarray:
+        """The same rows per point, shape ``(G, 4, n)``."""
+        return np.ascontiguousarray(
+            np.stack([self.N_eta, self.N_xi, self.M_eta, self.M_xi], axis=1))
+
+    @cached_property
+    def u_columns(self) -> np.ndarray:
+        """Boolean mask of the layer's u DOFs, shape ``(n,)``: N rows vanish off them, M rows on
+        them."""
+        return np.array([DOF_TABLE[int(d) % NODE_DOFS].field == "u" for d in self.dofs])
+
+    @cached_property
+    def field_products(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Products R_kᵀR_l of the reference rows per point, split by field (uu, ww, uw).
+
+        With R = (N,η, N,ξ, M,η, M,ξ): uu pairs k, l ∈ (N,η, N,ξ) on the u columns, shape
+        ``(4G, n_u²)``; ww pairs k, l ∈ (M,η, M,ξ) on the w columns, ``(4G, n_w²)``; uw pairs
+        k ∈ N rows, l ∈ M rows, ``(4G, n_u n_w)``. Rows are ordered (point, k, l).
+        """
+        u, w = self.u_columns, ~self.u_columns
+        Nr = np.stack([self.N_eta[:, u], self.N_xi[:, u]], axis=1)  # (G, 2, n_u)
+        Mr = np.stack([self.M_eta[:, w], self.M_xi[:, w]], axis=1)  # (G, 2, n_w)
+        G = self.eta.size
+
+        def prod(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+            return np.einsum("gka,glb->gklab", A, B).reshape(4 * G, -1)
+
+        return prod(Nr, Nr), prod(Mr, Mr), prod(Nr, Mr)
 
     def x_slope_scale(self, lengths: np.ndarray) -> np.ndarray:
         """Per-element DOF scale, shape ``(E, n)``: l/2 on x-slope DOFs, 1 elsewhere."""

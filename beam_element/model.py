@@ -19,7 +19,13 @@ from beam_element.constitutive import core_stiffness, face_stiffness
 from beam_element.constraints import DofMap, NodeSupport, build_dof_map
 from beam_element.contact import ContactPairs, contact_pairs, in_contact, penalty_response
 from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
-from beam_element.element import GeometricProducts, geometric_products, layer_response
+from beam_element.element import (
+    GeometricProducts,
+    LayerState,
+    geometric_products,
+    layer_state,
+    layer_tangent,
+)
 from beam_element.layer_operators import LayerOperators, build_layer_operators
 from beam_element.loads import patch_load, point_load, probe_row
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
@@ -61,7 +67,8 @@ class BeamModel:
     committed: dict[str, ContactSummary] = field(default_factory=dict)
     max_penetration_seen: float = 0.0
     max_sliding_seen: float = 0.0
-    _cache: tuple[np.ndarray, np.ndarray, sp.csr_matrix | None] | None = None
+    # (u, f, K or None, layer states of u): the tangent at the last force's u reuses its states.
+    _cache: tuple | None = None
 
     def __post_init__(self) -> None:
         e = np.arange(self.mesh.n_elements)[:, None]
@@ -122,40 +129,51 @@ class BeamModel:
         return self.dof_map.expand(u)
 
     def _evaluate(self, u: np.ndarray, tangent: bool) -> tuple[np.ndarray, sp.csr_matrix | None]:
-        if self._cache is not None and np.array_equal(self._cache[0], u):
-            if not tangent or self._cache[2] is not None:
-                return self._cache[1], self._cache[2]
-        f_full, blocks = self.full_response(self.expand(u), tangent)
+        cache = self._cache
+        if cache is not None and np.array_equal(cache[0], u):
+            if not tangent or cache[2] is not None:
+                return cache[1], cache[2]
+            # The force at this u is known: the tangent reuses its strains and stresses.
+            K = self.pattern.assemble(self._tangent_blocks(self.expand(u), cache[3]))
+            self._cache = (cache[0], cache[1], K, cache[3])
+            return cache[1], K
+        u_full = self.expand(u)
+        f_full, states = self._forces(u_full)
         f = self.dof_map.reduce(f_full)
-        K = self.pattern.assemble(blocks) if tangent else None
-        self._cache = (np.array(u, dtype=float, copy=True), f, K)
+        K = self.pattern.assemble(self._tangent_blocks(u_full, states)) if tangent else None
+        self._cache = (np.array(u, dtype=float, copy=True), f, K, states)
         return f, K
+
+    def _forces(self, u_full: np.ndarray) -> tuple[np.ndarray, dict[str, list[LayerState]]]:
+        """Internal force on the full DOFs and the layer states (per chunk) it came from."""
+        forces, states = [], {}
+        lengths = self.mesh.lengths
+        u_e = u_full[self.element_dofs]
+        for name in LAYERS:
+            op = self.layers[name]
+            states[name] = [layer_state(op, u_e[s:s + CHUNK], lengths[s:s + CHUNK], self.width)
+                            for s in range(0, self.mesh.n_elements, CHUNK)]
+            forces.append(np.concatenate([st.f for st in states[name]]))
+        for pairs in self.pairs:
+            forces.append(penalty_response(pairs, u_full, self.penalty, self.smoothing)[0])
+        return scatter_vector(u_full.size, self.block_dofs, forces), states
+
+    def _tangent_blocks(
+        self, u_full: np.ndarray, states: dict[str, list[LayerState]]
+    ) -> list[np.ndarray]:
+        """Local tangent blocks (layers, then contact) at the layer states of ``u_full``."""
+        blocks = [np.concatenate([layer_tangent(self.layers[name], st, self.products[name])
+                                  for st in states[name]]) for name in LAYERS]
+        for pairs in self.pairs:
+            blocks.append(penalty_response(pairs, u_full, self.penalty, self.smoothing)[1])
+        return blocks
 
     def full_response(
         self, u_full: np.ndarray, tangent: bool = True
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Internal force on the full DOFs and the local tangent blocks (layers, then contact)."""
-        forces, blocks = [], []
-        lengths = self.mesh.lengths
-        u_e = u_full[self.element_dofs]
-        for name in LAYERS:
-            op, n = self.layers[name], self.layers[name].dofs.size
-            f = np.empty((self.mesh.n_elements, n))
-            K = np.empty((self.mesh.n_elements, n, n)) if tangent else None
-            for s in range(0, self.mesh.n_elements, CHUNK):
-                block = slice(s, s + CHUNK)
-                f[block], Kb = layer_response(op, u_e[block], lengths[block], self.width,
-                                              self.products[name], tangent)
-                if K is not None:
-                    K[block] = Kb
-            forces.append(f)
-            blocks.append(K)
-        for pairs in self.pairs:
-            fc, Kc, _, _ = penalty_response(pairs, u_full, self.penalty, self.smoothing)
-            forces.append(fc)
-            blocks.append(Kc)
-        f_full = scatter_vector(u_full.size, self.block_dofs, forces)
-        return f_full, (blocks if tangent else [])
+        f_full, states = self._forces(u_full)
+        return f_full, (self._tangent_blocks(u_full, states) if tangent else [])
 
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
         """Penetration, pressure and sliding per interface at free DOFs ``u``."""
