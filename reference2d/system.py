@@ -145,6 +145,11 @@ class Reference2DSystem:
         du = ufl.TrialFunction(V)
         R = internal(self.u, v)
         self.R_form = fem.form(R, jit_params=JIT)
+        # det F at the nodes of a DG2 (Q2) field, for admissible(): one value per node per cell
+        self._detF = fem.Function(fem.FunctionSpace(V.mesh, ("DG", 2)))
+        self._detF_expr = fem.Expression(
+            ufl.det(ufl.Identity(2) + ufl.grad(self.u)),
+            self._detF.function_space.element.interpolation_points())
         self.J_form = fem.form(ufl.derivative(R, self.u, du), jit_params=JIT)
         self.bs = V.dofmap.index_map_bs
         im = V.dofmap.index_map
@@ -252,6 +257,30 @@ class Reference2DSystem:
         """Penalty contact keeps no history: store the contact state of the converged ``u``."""
         self._set_u(u)
         self.last_contact = [s for s, _ in self._contact_states(want_tangent=False)]
+
+    def admissible(self, u: np.ndarray) -> str:
+        """``""`` if det F > 0 at every node of every cell, else where it is not.
+
+        The Green-strain (St. Venant–Kirchhoff) law has equilibrium states with elements turned
+        inside out (det F ≤ 0): a core crushed past its material limit point (stretch 1/√3)
+        continues through det F = 0 into them. The path solver rejects such states.
+        """
+        self._set_u(u)
+        self._detF.interpolate(self._detF_expr)
+        d = self._detF.x.array
+        dm = self._detF.function_space.dofmap
+        n = dm.index_map.size_local * dm.bs  # owned nodes
+        i = int(np.argmin(d[:n])) if n else -1
+        local = (float(d[i]), i) if n else (np.inf, -1)
+        dmin = self.comm.allreduce(local[0], op=MPI.MIN)
+        if dmin > 0.0:
+            return ""
+        where = ""
+        if local[0] == dmin and i >= 0:
+            x = self._detF.function_space.tabulate_dof_coordinates()[i]
+            where = f" at x = {x[0]:.4g}, z = {x[1]:.4g}"
+        where = max(self.comm.allgather(where), key=len)
+        return f"element inverted, det F = {dmin:.3g} <= 0{where}"
 
     # -- helpers ---------------------------------------------------------------------------------
     def _set_u(self, u: np.ndarray) -> None:

@@ -12,6 +12,9 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
 - acceptance guard against jumps to a distant branch: the predictor may not be longer than
   ``max_predictor_growth`` × the previous step, and the corrector may not move farther than
   ``max_correction_ratio`` × the predictor length from the predictor (norm ``‖(Δu, ψΔλ)‖``);
+- a converged step whose state the model declares inadmissible (optional
+  ``system.admissible(u)`` returning a non-empty reason, e.g. an inverted element) is rejected
+  like a failed one, so the path never leaves the model's domain of physical meaning;
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
   (it never grows after a cut step) and is clipped to [min_increment, max_increment].
@@ -37,6 +40,7 @@ from sandwich.solver.system import DiscreteSystem, Factorization, inner_product
 __all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linear"]
 
 CONTROLS = ("load", "displacement", "arc-length")
+INADMISSIBLE = "inadmissible state"  # prefix of the reason of a step rejected by admissible()
 
 
 @dataclass
@@ -178,6 +182,8 @@ class _Follower:
         self.c = {n: np.asarray(system.probe_vector(n), dtype=float) for n in names}
         self.f_ref = np.asarray(system.f_ref, dtype=float)
         self.states: list[PathState] = []
+        admissible = getattr(system, "admissible", None)
+        self.admissible = admissible if callable(admissible) else None
 
     # -- helpers -------------------------------------------------------------------------------
     def probes(self, u: np.ndarray) -> dict[str, float]:
@@ -247,7 +253,11 @@ class _Follower:
                 cuts += 1
                 if h < h_min:
                     hint = ""
-                    if opt.control == "load":
+                    if reason.startswith(INADMISSIBLE):
+                        hint = (" The path leaves the model's admissible domain here (its "
+                                "equations have no physical meaning beyond); the states before "
+                                "it are kept.")
+                    elif opt.control == "load":
                         hint = (" Under load control this usually means a load maximum (limit "
                                 "point) is near; use displacement or arc-length control.")
                     elif opt.control == "displacement":
@@ -398,6 +408,10 @@ class _Follower:
         if dist > opt.max_correction_ratio * pred_len:
             return None, (f"corrector moved {dist:.3g} from a predictor of length {pred_len:.3g}"
                           f" (jump to another branch?)")
+        if self.admissible is not None:
+            why = self.admissible(res.u)
+            if why:
+                return None, f"{INADMISSIBLE}: {why}"
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization), "converged"
 
     def _crossings(self, last: PathState, trial: _Trial) -> list[tuple[float, str, float]]:

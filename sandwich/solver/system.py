@@ -10,6 +10,12 @@ with ``f_ref`` the reference (dead) load of the scene and λ the load factor.
 A system distributed over MPI ranks (each rank holding its owned entries of every vector) may
 also provide ``dot(a, b) -> float``, the global inner product; the solver then uses it for every
 inner product and norm (:func:`inner_product`), and falls back to ``float(a @ b)`` without it.
+
+A system may also provide ``admissible(u) -> str``: ``""`` if ``u`` is a physically meaningful
+state of the model, else the reason (e.g. an element turned inside out, det F ≤ 0). The path
+solver rejects a converged step whose state is inadmissible (the step is cut), so it never
+follows the model's equations into a region where they have no physical meaning (the
+St. Venant–Kirchhoff law, for one, has equilibrium states with inverted elements).
 """
 
 from __future__ import annotations

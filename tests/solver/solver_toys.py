@@ -159,3 +159,46 @@ class Saturating(ToySystem):
 
     def tangent(self, u: np.ndarray) -> np.ndarray:
         return np.array([[1.0 / np.cosh(u[0]) ** 2]])
+
+
+class SvkBar(ToySystem):
+    """A St. Venant–Kirchhoff bar (length ``L``, axial stiffness ``EA``) crushed by ``λ P``.
+
+    Shortening ``w``, stretch ``s = 1 − w/L``; the Green-strain law S = E (s² − 1)/2 gives the
+    compressive resistance
+
+        f(w)  = EA s (1 − s²) / 2,        f'(w) = EA (3 s² − 1) / (2 L),
+
+    a material limit point at ``s = 1/√3`` (``λ_max P = EA / (3√3)``), zero force at ``s = 0``
+    (the bar crushed flat) and, beyond, equilibrium states with the bar turned inside out
+    (``s < 0``) and λ < 0 — the law has no physical meaning there. With ``guard`` the system
+    declares those states inadmissible (``admissible(u)``), as the 2D reference does for
+    det F ≤ 0.
+    """
+
+    dof_names = ("w",)
+
+    def __init__(self, ea: float = 100.0, length: float = 1.0, guard: bool = True) -> None:
+        super().__init__()
+        self.ea, self.length = ea, length
+        if guard:
+            self.admissible = self._admissible
+
+    def stretch(self, w: np.ndarray | float) -> np.ndarray | float:
+        return 1.0 - np.asarray(w, dtype=float) / self.length
+
+    def force(self, w: np.ndarray | float) -> np.ndarray | float:
+        s = self.stretch(w)
+        return 0.5 * self.ea * s * (1.0 - s * s)
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        self.evaluations += 1
+        return np.array([float(self.force(u[0]))])
+
+    def tangent(self, u: np.ndarray) -> np.ndarray:
+        s = float(self.stretch(u[0]))
+        return np.array([[0.5 * self.ea * (3.0 * s * s - 1.0) / self.length]])
+
+    def _admissible(self, u: np.ndarray) -> str:
+        s = float(self.stretch(u[0]))
+        return "" if s > 0.0 else f"bar inverted (stretch {s:.3g} <= 0)"
