@@ -58,3 +58,27 @@ def sandwich_scene(
 
 __all__ = ["Debond", "Load", "Probe", "Support", "sandwich_scene", "KEVLAR", "ROHACELL",
            "isotropic"]
+
+
+def assert_layer_derivatives(op, u, lengths, width=60.0, step=1e-6):
+    """Check force = ∂energy/∂u and tangent = ∂force/∂u of one layer by central differences.
+
+    Returns the layer's force and tangent at ``u``.
+    """
+    import numpy as np
+
+    from beam_element.element import layer_energy, layer_response
+
+    f, K = layer_response(op, u, lengths, width)
+    K_fd, f_fd = np.zeros_like(K), np.zeros_like(f)
+    for a, d in enumerate(op.dofs):
+        du = np.zeros_like(u)
+        du[:, d] = step
+        f_plus = layer_response(op, u + du, lengths, width, tangent=False)[0]
+        f_minus = layer_response(op, u - du, lengths, width, tangent=False)[0]
+        K_fd[:, :, a] = (f_plus - f_minus) / (2 * step)
+        f_fd[:, a] = (layer_energy(op, u + du, lengths, width)
+                      - layer_energy(op, u - du, lengths, width)) / (2 * step)
+    assert np.max(np.abs(K - K_fd)) < 1e-6 * np.max(np.abs(K))
+    assert np.max(np.abs(f - f_fd)) < 1e-6 * np.max(np.abs(f))
+    return f, K

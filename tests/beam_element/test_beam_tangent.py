@@ -7,12 +7,11 @@ bonded and debonded interfaces and contact active. Also: f_int = ∂(strain ener
 
 import numpy as np
 import pytest
-from beam_scenes import KEVLAR, ROHACELL, Debond, sandwich_scene  # noqa: I001
+from beam_scenes import KEVLAR, ROHACELL, Debond, assert_layer_derivatives, sandwich_scene  # noqa: I001
 
 from beam_element.constitutive import core_stiffness, face_stiffness
 from beam_element.contact import contact_pairs, pair_kinematics, penalty_response
 from beam_element.dofs import global_dof
-from beam_element.element import layer_energy, layer_response
 from beam_element.layer_operators import build_layer_operators
 from beam_element.model import build_model
 from beam_element.quadrature import EXACT_ORDER
@@ -31,19 +30,7 @@ def test_layer_tangent_matches_finite_differences(name, h, C):
     op = build_layer_operators(name, h, 0.0, C, gauss=EXACT_ORDER[name])
     lengths = np.array([4.0, 9.0, 2.5])
     u = _random_state(rng, 3, 0.5)  # gradients u/l of order 0.1 - 0.3
-    f, K = layer_response(op, u, lengths, 60.0)
-    step = 1e-6
-    K_fd = np.zeros_like(K)
-    f_fd = np.zeros_like(f)
-    for a, d in enumerate(op.dofs):
-        du = np.zeros_like(u)
-        du[:, d] = step
-        K_fd[:, :, a] = (layer_response(op, u + du, lengths, 60.0, tangent=False)[0]
-                         - layer_response(op, u - du, lengths, 60.0, tangent=False)[0]) / (2 * step)
-        f_fd[:, a] = (layer_energy(op, u + du, lengths, 60.0)
-                      - layer_energy(op, u - du, lengths, 60.0)) / (2 * step)
-    assert np.max(np.abs(K - K_fd)) < 1e-6 * np.max(np.abs(K))
-    assert np.max(np.abs(f - f_fd)) < 1e-6 * np.max(np.abs(f))
+    f, K = assert_layer_derivatives(op, u, lengths)
     assert np.max(np.abs(K - K.transpose(0, 2, 1))) < 1e-12 * np.max(np.abs(K))
 
 

@@ -7,7 +7,7 @@ paper's element (identical linear stiffness: the option changes only the Â½ w,xÂ
 
 import numpy as np
 import pytest
-from beam_scenes import KEVLAR  # noqa: I001
+from beam_scenes import KEVLAR, assert_layer_derivatives  # noqa: I001
 
 from beam_element.constitutive import face_stiffness
 from beam_element.dofs import DOF_TABLE
@@ -28,18 +28,7 @@ def test_averaged_face_tangent_and_force_match_finite_differences():
     op = _op(True)
     lengths = np.array([4.0, 9.0, 2.5])
     u = rng.normal(size=(3, 40)) * 0.5
-    f, K = layer_response(op, u, lengths, 60.0)
-    step = 1e-6
-    K_fd, f_fd = np.zeros_like(K), np.zeros_like(f)
-    for a, d in enumerate(op.dofs):
-        du = np.zeros_like(u)
-        du[:, d] = step
-        K_fd[:, :, a] = (layer_response(op, u + du, lengths, 60.0, tangent=False)[0]
-                         - layer_response(op, u - du, lengths, 60.0, tangent=False)[0]) / (2 * step)
-        f_fd[:, a] = (layer_energy(op, u + du, lengths, 60.0)
-                      - layer_energy(op, u - du, lengths, 60.0)) / (2 * step)
-    assert np.max(np.abs(K - K_fd)) < 1e-6 * np.max(np.abs(K))
-    assert np.max(np.abs(f - f_fd)) < 1e-6 * np.max(np.abs(f))
+    f, K = assert_layer_derivatives(op, u, lengths)
     # and it differs from the paper's element at this state (the option does something)
     f_paper, _ = layer_response(_op(False), u, lengths, 60.0, tangent=False)
     assert np.max(np.abs(f - f_paper)) > 1e-3 * np.max(np.abs(f))
