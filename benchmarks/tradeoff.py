@@ -13,8 +13,14 @@ every resolution; wall times are measured here. The error of every run is taken 
 Writes ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` (error vs time, Pareto fronts)
 into ``benchmarks/results/comparisons/``.
 
+Beam variants: ``paper`` (the paper's element) and ``averaged`` (``face_membrane = "averaged"``,
+not the paper's, see docs/beam_vs_2d.md). ``--until NAME=VALUE`` ends a scene's path earlier (the
+fig4 2D core crushes at w ≈ −13 mm, so its path is compared to −12 mm). Wall and CPU seconds are
+both recorded: on a shared machine the CPU time is the steadier of the two.
+
 Usage: ``python benchmarks/tradeoff.py [--elements 15 30 60 120] [--levels coarse medium fine]
-[--refine 0 1] [--scenes paper-fig4-bonded-3pb ...]``
+[--refine 0 1] [--scenes paper-fig4-bonded-3pb ...] [--variants paper averaged]
+[--until paper-fig4-bonded-3pb=-12]``
 """
 
 from __future__ import annotations
@@ -56,23 +62,31 @@ class Run:
     final_probes: dict[str, float]
     error: float | None = None  # load at the end of the path vs finest 2D
     probe_errors: dict[str, float] = dataclasses.field(default_factory=dict)
+    cpu_seconds: float = math.nan
 
 
-def with_beam_elements(scene: Scene, n: int) -> Scene:
-    return dataclasses.replace(scene, beam_model=dataclasses.replace(scene.beam_model,
-                                                                     elements=n))
+def with_beam_elements(scene: Scene, n: int, variant: str = "paper") -> Scene:
+    return dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, elements=n, face_membrane=variant))
+
+
+def with_until(scene: Scene, value: float) -> Scene:
+    return dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
+                                                                   until_value=value))
 
 
 def timed(label: str, scene: Scene, model: str, solve: Callable[[], Solution]) -> Run:
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     s = solve()
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     last = s.history[-1] if s.history else None
     return Run(scene.name, model, label, seconds, s.dofs, s.converged,
-               last.load_factor if last else math.nan, dict(last.probes) if last else {})
+               last.load_factor if last else math.nan, dict(last.probes) if last else {},
+               cpu_seconds=cpu)
 
 
-def measure(scene: Scene, beam_solve, ref_solve, elements, levels, refines) -> list[Run]:
+def measure(scene: Scene, beam_solve, ref_solve, elements, levels, refines,
+            variants: tuple[str, ...] = ("paper",)) -> list[Run]:
     """Run every resolution of both models on ``scene``; errors against the finest 2D run."""
     runs = []
     for level in levels:
@@ -80,10 +94,12 @@ def measure(scene: Scene, beam_solve, ref_solve, elements, levels, refines) -> l
             print(f"{scene.name}: 2d level={level} refine={refine}", flush=True)
             runs.append(timed(f"{level}+{refine}", scene, "2d",
                               lambda: ref_solve(scene, level=level, refine=refine)))  # noqa: B023
-    for n in elements:
-        print(f"{scene.name}: beam elements={n}", flush=True)
-        sc = with_beam_elements(scene, n)
-        runs.append(timed(str(n), scene, "beam", lambda: beam_solve(sc)))  # noqa: B023
+    for variant in variants:
+        for n in elements:
+            print(f"{scene.name}: beam elements={n} {variant}", flush=True)
+            sc = with_beam_elements(scene, n, variant)
+            label = str(n) if variant == "paper" else f"{n} {variant}"
+            runs.append(timed(label, scene, "beam", lambda: beam_solve(sc)))  # noqa: B023
     ref = [r for r in runs if r.model == "2d" and r.converged]
     if not ref:
         return runs
@@ -132,19 +148,22 @@ def write(runs: list[Run], lines: list[str], out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     with (out / "tradeoff.csv").open("w", newline="") as fh:
         w = csv.writer(fh, lineterminator="\n")
-        w.writerow(["scene", "model", "resolution", "seconds", "dofs", "converged",
-                    "final_load_factor", "error_load_end"])
+        w.writerow(["scene", "model", "resolution", "seconds", "cpu_seconds", "dofs",
+                    "converged", "final_load_factor", "error_load_end"])
         for r in runs:
-            w.writerow([r.scene, r.model, r.resolution, f"{r.seconds:.6g}", r.dofs, r.converged,
+            w.writerow([r.scene, r.model, r.resolution, f"{r.seconds:.6g}",
+                        "" if math.isnan(r.cpu_seconds) else f"{r.cpu_seconds:.6g}", r.dofs,
+                        r.converged,
                         "" if math.isnan(r.final_load_factor) else repr(r.final_load_factor),
                         "" if r.error is None else repr(r.error)])
     md = ["# Speed/accuracy trade (benchmarks/tradeoff.py)", "",
           "Error: load at the end of the path (the mid-span probe at its target) against the "
           "finest 2D run; time measured in the same process.", ""]
     md += [f"- {line}" for line in lines] + ["",
-           "| scene | model | resolution | time (s) | DOFs | converged | error |",
-           "|---|---|---|---|---|---|---|"]
-    md += [f"| {r.scene} | {r.model} | {r.resolution} | {r.seconds:.3g} | {r.dofs} | "
+           "| scene | model | resolution | wall (s) | CPU (s) | DOFs | converged | error |",
+           "|---|---|---|---|---|---|---|---|"]
+    md += [f"| {r.scene} | {r.model} | {r.resolution} | {r.seconds:.3g} | "
+           f"{r.cpu_seconds:.3g} | {r.dofs} | "
            f"{r.converged} | {'—' if r.error is None else f'{100 * r.error:.3f} %'} |"
            for r in runs]
     md += ["", "![error vs time](tradeoff.png)", ""]
@@ -175,18 +194,37 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--elements", nargs="+", type=int, default=[15, 30, 60, 120, 240])
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium", "fine"])
     ap.add_argument("--refine", nargs="+", type=int, default=[0])
+    ap.add_argument("--variants", nargs="+", default=["paper", "averaged"],
+                    choices=["paper", "averaged"])
+    ap.add_argument("--until", nargs="+", default=["paper-fig4-bonded-3pb=-12"],
+                    metavar="SCENE=VALUE", help="end a scene's path at this probe value")
     ap.add_argument("--out", type=Path, default=OUT)
     args = ap.parse_args(argv)
+    until = {}
+    for item in args.until:
+        name, _, value = item.partition("=")
+        try:
+            until[name] = float(value)
+        except ValueError:
+            ap.error(f"--until {item!r}: expected SCENE=VALUE with a number")
+    import os
+    import platform
+
     import beam_element
     import reference2d
 
     runs, lines = [], []
     for name in args.scenes:
         scene = load_scene(ROOT / "scenes" / f"{name}.toml")
+        if name in until:
+            scene = with_until(scene, until[name])
+        load = os.getloadavg()[0]
         rs = measure(scene, beam_element.solve, reference2d.solve, args.elements, args.levels,
-                     args.refine)
+                     args.refine, tuple(args.variants))
         runs += rs
-        lines.append(headline(rs, name))
+        lines.append(headline(rs, name) + f" [path to {scene.analysis.until_probe} = "
+                     f"{scene.analysis.until_value:g}; load average {load:.2f} at start, "
+                     f"{os.getloadavg()[0]:.2f} at end, {platform.node()}]")
         write(runs, lines, args.out)  # after each scene: a partial table survives a crash
     print("\n".join(lines))
     return 0
