@@ -6,7 +6,9 @@ in mm, with z = 0 at the core mid-plane:
 
 - supports act on the face's end section x = x_s, h_face wide: "roller" fixes w on every node of
   the section, "pin" fixes w on every node and u on the node at the face's mid-surface, "clamp"
-  fixes u and w on every node (the core's section is free);
+  fixes u and w on every node (the core's section is free). The section's nodes are the nodes
+  of the face's *cells* at x = x_s: where a debond reaches the support (an open mouth), the
+  core's corner node sits at the same point as the face's lip node and stays free;
 - a patch load is a uniform dead traction on the loaded face's outer edge over [x − w/2, x + w/2],
   scaled so that it carries exactly the scene's total force; a point load is a nodal force at the
   outer-edge node nearest to x;
@@ -97,7 +99,9 @@ def build_model(scene: Scene, mesh, penalty: float | None = None) -> Model2D:
     n_local = (V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts) * 2
     X = V.tabulate_dof_coordinates()[:, :2]
     n_owned = V.dofmap.index_map.size_local
-    bc = support_dofs(scene, X, comm=V.mesh.comm)
+    bc = support_dofs(scene, X, comm=V.mesh.comm,
+                      in_face={f: face_node_mask(V, X, face_band(scene, f))
+                               for f in ("top", "bottom")})
     f_ref = load_vector(scene, V, X, n_local, n_owned=n_owned)
     probes = {p.name: probe_vector(V, p.x, face_band(scene, p.on), n_local)
               for p in scene.probes}
@@ -109,12 +113,37 @@ def build_model(scene: Scene, mesh, penalty: float | None = None) -> Model2D:
     return Model2D(scene, mesh, disc, stiffness, system, pairs, ifaces, k)
 
 
-def support_dofs(scene: Scene, X: np.ndarray, comm=None) -> np.ndarray:
+def face_node_mask(V, X: np.ndarray, band: LayerBand) -> np.ndarray:
+    """(local blocks,) True for the DOF blocks of cells whose centroid lies in ``band``.
+
+    The layer of a cell is the band containing its centroid (as for the material). A node on a
+    bonded interface belongs to cells of both layers; a core node on a debond lip does not
+    belong to any face cell, even where it coincides with the face's lip node. Under MPI the
+    flags are summed onto the owners and sent back to the ghosts, so a node whose face cell lies
+    on another rank is still flagged.
+    """
+    n_cell_dofs = V.dofmap.dof_layout.num_dofs
+    blocks = np.asarray(V.dofmap.list.array, dtype=np.int64).reshape(-1, n_cell_dofs)
+    zc = X[blocks, 1].mean(axis=1)
+    cells = (zc > band.z_lo) & (zc < band.z_hi)
+    e = fem.Function(V)
+    e.x.array[:] = 0.0
+    e.x.array[2 * np.unique(blocks[cells])] = 1.0
+    e.vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    e.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    return e.x.array[0::2] > 0.0
+
+
+def support_dofs(scene: Scene, X: np.ndarray, comm=None,
+                 in_face: dict[str, np.ndarray] | None = None) -> np.ndarray:
     """Unrolled local DOF indices fixed by the scene's supports (u: 2 i, w: 2 i + 1).
 
-    ``X`` holds the coordinates of this rank's DOF blocks (owned and ghost). Under MPI a support
-    section may lie partly or wholly on other ranks: the "no node there" check and the pin's
-    mid-surface node are decided over all ranks (``comm``).
+    ``X`` holds the coordinates of this rank's DOF blocks (owned and ghost). ``in_face`` maps
+    "top"/"bottom" to a mask of the blocks that belong to that face's cells
+    (:func:`face_node_mask`); without it the section is every node at x = x_s within the face's
+    z-band, which wrongly takes the core's corner node where a debond reaches the support.
+    Under MPI a support section may lie partly or wholly on other ranks: the "no node there"
+    check and the pin's mid-surface node are decided over all ranks (``comm``).
     """
     def global_min(v: float) -> float:
         return v if comm is None or comm.size == 1 else comm.allreduce(v, op=MPI.MIN)
@@ -123,9 +152,11 @@ def support_dofs(scene: Scene, X: np.ndarray, comm=None) -> np.ndarray:
     for s in scene.supports:
         for face in s.faces:
             band = face_band(scene, face)
-            section = np.where((np.abs(X[:, 0] - s.x) < GEOM_TOL)
-                               & (X[:, 1] > band.z_lo - GEOM_TOL)
-                               & (X[:, 1] < band.z_hi + GEOM_TOL))[0]
+            on = ((np.abs(X[:, 0] - s.x) < GEOM_TOL) & (X[:, 1] > band.z_lo - GEOM_TOL)
+                  & (X[:, 1] < band.z_hi + GEOM_TOL))
+            if in_face is not None:
+                on &= in_face[face]
+            section = np.flatnonzero(on)
             if global_min(0.0 if len(section) else 1.0) > 0.0:
                 raise ValueError(f"support at x = {s.x} on the {face} face: no mesh node there")
             fixed.append(2 * section + 1)  # w on the whole section

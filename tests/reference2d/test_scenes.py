@@ -61,8 +61,14 @@ def test_fig5_debond_closes_under_the_load_coarse_short_path():
     assert np.all(prof["p_contact_top"][outside] == 0)
 
 
+FIG4_CRUSH = pytest.mark.xfail(strict=True, reason=(
+    "the Green-strain core (eq. 27) crushes under the patch: material limit point "
+    "lambda=1930.67 at w=-12.99 mm, next steps invert core cells (det F guard stops the path at "
+    "w=-13.08 mm); -15 mm is out of reach (docs/reference2d.md)"))
+
+
 @pytest.mark.heavy
-@pytest.mark.parametrize("name", [FIG4, FIG5])
+@pytest.mark.parametrize("name", [pytest.param(FIG4, marks=FIG4_CRUSH), FIG5])
 def test_full_path_coarse(name):
     scene = load_scene(SCENES / f"{name}.toml")
     sol = solve(scene, level="coarse")
