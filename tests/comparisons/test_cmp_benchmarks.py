@@ -1,9 +1,12 @@
 """Plumbing of benchmarks/tradeoff.py and benchmarks/extremes.py with synthetic solvers."""
 
+import dataclasses
 import importlib.util
 import math
 import sys
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -67,20 +70,63 @@ def test_extremes_cases_rows_and_map(tmp_path, scene, synth):
     whole = made[("debond", 1.0)].debonds[0]
     assert (whole.start, whole.end) == (0.0, scene.length)
 
-    def broken(sc):
+    def broken(sc, progress=None):
         raise RuntimeError("diverged at step 2")
 
+    def skipped(sc, progress=None):
+        raise extremes.Skipped("2D mesh has 99999 cells, above the budget")
+
     rows = []
-    for key in [("load", 1.0), ("debond", 0.3)]:
-        solvers = {"beam": lambda sc: synth.make_solution("beam", eps=0.02),
-                   "2d": (lambda sc: synth.make_solution("2d")) if key[0] == "load" else broken}
-        rows.append(extremes.row(*key, made[key], extremes.run_case(made[key], solvers)))
+    for key, ref in [(("load", 1.0), None), (("debond", 0.3), broken),
+                     (("slenderness", 1000), skipped)]:
+        solvers = {"beam": lambda sc, progress=None: synth.make_solution("beam", eps=0.02),
+                   "2d": ref or (lambda sc, progress=None: synth.make_solution("2d"))}
+        rows.append(extremes.row(*key, made[key], extremes.run_models(made[key], solvers)))
     assert rows[0]["load_l2"] == pytest.approx(0.02, abs=5e-4)
     assert rows[0]["beam_cuts"] == 50  # the synthetic history marks a cut every third step
-    assert rows[1]["2d_converged"] is False and "diverged at step 2" in rows[1]["2d_note"]
-    assert rows[1]["load_l2"] is None
+    assert rows[0]["2d_status"] == "converged" and rows[0]["common"] == pytest.approx(1.0)
+    assert rows[1]["2d_status"] == "failed" and "diverged at step 2" in rows[1]["2d_note"]
+    assert rows[1]["load_l2"] is None and "2D has no converged state" in rows[1]["agree_note"]
+    assert rows[2]["2d_status"] == "skipped" and "99999 cells" in rows[2]["2d_note"]
     extremes.write(rows, tmp_path)
     text = (tmp_path / "extremes.md").read_text()
-    assert "| load | 1 | ✓ | ✓ |" in text and "| debond | 0.3 | ✓ | ✗ |" in text
+    assert "| load | 1 | ✓ | ✓ |" in text and "| debond | 0.3 | ✓ | ✗! |" in text
+    assert "| slenderness | 1000 | ✓ | – |" in text and "99999 cells" in text
     assert not any(isinstance(v, float) and math.isnan(v) for r in rows for v in r.values())
     assert (tmp_path / "extremes.png").is_file()
+    assert "nan" not in (tmp_path / "extremes.csv").read_text().lower()
+
+
+def test_extremes_agreement_over_the_common_range_when_a_model_stops_early(scene, synth):
+    extremes = _load("extremes")
+    full = synth.make_solution("2d")
+    beam = synth.make_solution("beam", eps=0.05)
+    half = dataclasses.replace(beam, history=beam.history[:75], converged=False)  # to −7.5 mm
+    a = extremes.agreement(scene, half, full)
+    assert a["common"] == pytest.approx(0.5, abs=1e-9)
+    assert a["load_l2"] == pytest.approx(0.05, rel=1e-6)  # exact: beam = 2D × 1.05 at samples
+    assert a["end_error"] == pytest.approx(0.05, rel=1e-6)
+    assert a["load_l2_lin"] == pytest.approx(0.05, rel=1e-3)
+    assert "beam stopped early" in a["agree_note"] and "50 %" in a["agree_note"]
+
+
+def test_extremes_wall_time_cap_keeps_the_streamed_states(scene, synth):
+    extremes = _load("extremes")
+
+    def slow(sc, progress=None):
+        for i in range(1, 4):  # three converged states, then a hang
+            progress(SimpleNamespace(step=i, load_factor=10.0 * i, iterations=3, cuts=i % 2,
+                                     probes={"w_top_mid": -1.0 * i, "w_bottom_mid": -0.9 * i}))
+        time.sleep(60)
+
+    t0 = time.perf_counter()
+    out = extremes.run_models(scene, {"2d": slow}, timeout=1.5)
+    assert time.perf_counter() - t0 < 20
+    run = out["2d"]
+    assert run.status == "timeout" and "wall-time cap of 1.5 s" in run.reason
+    assert [r.load_factor for r in run.solution.history] == [10.0, 20.0, 30.0]
+    assert run.cuts == 2
+    r = extremes.row("load", 1.0, scene, {**out, "beam": extremes.Outcome(
+        "beam", "converged", synth.make_solution("beam"))})
+    assert r["2d_reached"] == pytest.approx(3.0 / 15.0)
+    assert r["common"] == pytest.approx(0.2) and "2D stopped early" in r["agree_note"]
