@@ -1,15 +1,62 @@
 """Frictionless unilateral contact on debonded stretches (eqs. 41-42), by a penalty.
 
 Pairing. Nodes strictly inside a debond are untied; at each of them the face's inner surface
-(master) is paired with the core boundary point of the *same material coordinate x* (slave).
-This node-to-node pairing assumes small relative sliding; the sliding s = t·Δ is returned so a
-user can check it (a sliding of a fraction of an element means the pairing is no longer apt).
+point (master) meets the core's boundary curve (slave). Two searches (``contact_pairs(search=)``):
 
-Gap (eq. 42). The slave boundary's deformed tangent is t ∝ (1 + u_c,x, w_c,x), its outward normal
-n = s_n (−w_c,x, 1 + u_c,x)/ℓ with ℓ = |(1 + u_c,x, w_c,x)| and s_n = +1 on the core's top,
-−1 on its bottom, i.e. n = s_n(−sin β, cos β) with β the slope angle of eq. (42). With the
-displacement jump Δ = (u_face − u_core, w_face − w_core) (face and core surfaces coincide in the
-reference state),
+* ``"closest-point"`` (default of :func:`beam_element.model.build_model`): node-to-segment. The
+  master point is projected on the deformed core boundary curve, the gap is measured along the
+  slave's deformed normal at the projection, and the linearisation includes the motion of the
+  projection point (below).
+* ``"same-x"``: node-to-node, the core boundary point of the *same material coordinate x*. It
+  assumes small relative sliding; the sliding s = t·Δ is returned so a user can check it.
+
+Closest point (node-to-segment; Wriggers, Computational Contact Mechanics, §4.3 and §8.2 for the
+2D node-to-segment element with a curved segment; here written for the implicit function ξ(q)).
+On a core segment [x_a, x_b] of length l, ξ ∈ [0, 1], the deformed boundary is
+
+    X(ξ) = (x_a + l ξ + Σ_k N_k(ξ) U_k,  z + Σ_k N_k(ξ) W_k),
+
+N = (H_a, l H̄_a, H_b, l H̄_b) the element's cubic Hermite functions in x (``"H"``, ``"Hbar"`` of
+:mod:`beam_element.shape_functions` with η = 2ξ − 1), U = (u_c, u_c,x) and W = (w_c, w_c,x) at
+the segment's two nodes. The master point is x_s = (x_i + u_face, z + w_face) (face and core
+surfaces coincide in the reference state, so z cancels). With r(ξ) = x_s − X(ξ) and the tangent
+X_ξ = (a, c) = (l + Σ N'_k U_k, Σ N'_k W_k), the projection solves
+
+    φ(ξ, q) = r · X_ξ = 0          (Newton: ξ ← ξ − φ/φ_ξ, φ_ξ = −|X_ξ|² + r·X_ξξ),
+
+vectorised over pairs and candidate segments (those within ``reach`` mm on each side of the node,
+at least one per side; a fixed maximum of iterations, stopping when every |Δξ| < 1e-12). The
+chosen segment is one whose ξ lies in [0, 1], the nearest (smallest |r|) if several do; the core
+boundary is C¹ across nodes (shared slope DOFs), so at a node both neighbours give the same point.
+If none does (sliding beyond the searched reach) the segment least outside is extrapolated and
+the pair is flagged ``outside``. The gap along the slave's deformed normal n = s_n (−c, a)/ℓ,
+ℓ = |X_ξ|, is
+
+    g̃(ξ, q) = n · r = s_n (a r₂ − c r₁)/ℓ,      g(q) = g̃(ξ(q), q),
+
+the same expression as the same-x gap with Δ → r and (1 + u_c,x, w_c,x) → X_ξ (g̃ is homogeneous
+of degree 0 in X_ξ). Linearisation: q = (u_face, w_face, U, W) of the segment and y = (ξ, q).
+(r₁, r₂, a, c) are linear in q at fixed ξ, so their Jacobian J = ∂(r₁, r₂, a, c)/∂y and their
+second derivatives Z (non-zero only in the ξ row and column: ∂²r/∂ξ² = −X_ξξ,
+∂²r/∂ξ∂q = −N', ∂²X_ξ/∂ξ² = X_ξξξ, ∂²X_ξ/∂ξ∂q = N'') are closed forms, and the chain rule gives
+g̃_y = g̃_z J and g̃_yy = Jᵀ g̃_zz J + Σ_α g̃_α Z_α (z = (r₁, r₂, a, c), g̃_z, g̃_zz as for the same-x
+gap). At the projection g̃_ξ = s_n r·n_ξ = 0, since n_ξ ∥ X_ξ ⊥ r; hence
+
+    ∂g/∂q = g̃_q                                    (the normal's and ξ's variations drop),
+    ∂²g/∂q² = g̃_qq + g̃_qξ ⊗ ξ_q + ξ_q ⊗ g̃_ξq + g̃_ξξ ξ_q ⊗ ξ_q,   ξ_q = −φ_q/φ_ξ
+
+(implicit function theorem on φ = 0; the g̃_ξ ξ_qq term vanishes with g̃_ξ). The ξ_q terms are
+the classical NTS terms of the moving contact point (with the curvature through X_ξξ and
+g̃_ξξ); g̃_qq holds the rotation of the normal. The gap is C¹ in q across segment switches
+(n and the nodal values are continuous there); its Hessian jumps with the curvature. Force and
+tangent act on the pair's block (face node + core nodes of the searched segments), so the sparse
+pattern is fixed. The sliding reported is the material distance x(ξ) − x_i of the projection.
+
+Gap (eq. 42), same-x. The slave boundary's deformed tangent is t ∝ (1 + u_c,x, w_c,x), its
+outward normal n = s_n (−w_c,x, 1 + u_c,x)/ℓ with ℓ = |(1 + u_c,x, w_c,x)| and s_n = +1 on the
+core's top, −1 on its bottom, i.e. n = s_n(−sin β, cos β) with β the slope angle of eq. (42).
+With the displacement jump Δ = (u_face − u_core, w_face − w_core) (face and core surfaces
+coincide in the reference state),
 
     g = n · Δ = s_n (−w_c,x Δu + (1 + u_c,x) Δw) / ℓ,
 
@@ -54,9 +101,16 @@ import numpy as np
 
 from beam_element.dofs import CONTACT_DOFS, global_dof
 
-# Local order of a contact pair's six DOFs.
+SEARCHES = ("closest-point", "same-x")
+# Local order of a same-x contact pair's six DOFs.
 PAIR_ROLES = ("u_face", "w_face", "u_core", "w_core", "u_core,x", "w_core,x")
+# Local order of the four DOFs of one core boundary node in a closest-point pair's block.
+CORE_NODE_ROLES = ("u_core", "u_core,x", "w_core", "w_core,x")
 NORMAL_SIGN = {"top": 1.0, "bottom": -1.0}
+DEFAULT_REACH = 1.0  # mm: closest-point search covers at least this far on each side of a node
+PROJECTION_TOL = 1e-12  # |Δξ| at which the projection Newton stops
+PROJECTION_MAX_ITERATIONS = 30
+IN_SEGMENT_TOL = 1e-10  # ξ ∈ [−tol, 1 + tol] counts as on the segment
 
 # d(Δu, Δw, a = 1 + u_c,x, c = w_c,x) / d(pair DOFs): the chain from gap variables to DOFs.
 _D = np.array([
@@ -69,71 +123,258 @@ _D = np.array([
 
 @dataclass(frozen=True)
 class ContactPairs:
-    """Node-to-node contact pairs of one interface."""
+    """Contact pairs of one interface: one per untied face node (master).
+
+    ``dofs`` are the node's own six same-x DOFs (PAIR_ROLES); the linear analysis
+    (:func:`beam_element.solve.linear_solution`) and the same-x search use them. A closest-point
+    pair (``search == "closest-point"``) also carries the core boundary nodes ``core_nodes``
+    (i − k … i + k, clamped to the mesh) whose segments it searches; its force and tangent live on
+    ``block_dofs`` = (u_face, w_face, then CORE_NODE_ROLES of each core node).
+    """
 
     interface: str
     nodes: np.ndarray  # (m,)
     area: np.ndarray  # (m,) tributary area b · l_trib (mm²)
     dofs: np.ndarray  # (m, 6) full DOF indices in PAIR_ROLES order
+    search: str = "same-x"
+    x: np.ndarray | None = None  # (n_nodes,) reference node coordinates (closest-point)
+    core_nodes: np.ndarray | None = None  # (m, 2k + 1) (closest-point)
+    segment_valid: np.ndarray | None = None  # (m, 2k): segment j joins core_nodes j and j + 1
+    support_dofs: np.ndarray | None = None  # (m, 2 + 4 (2k + 1)) (closest-point)
 
     @property
     def size(self) -> int:
         """Number of pairs."""
         return int(self.nodes.size)
 
+    @property
+    def block_dofs(self) -> np.ndarray:
+        """Full DOF indices of the force and tangent blocks of :func:`penalty_response`."""
+        return self.dofs if self.search == "same-x" else self.support_dofs
 
-def contact_pairs(interface: str, nodes: np.ndarray, x: np.ndarray, width: float) -> ContactPairs:
-    """Pairs at ``nodes`` (indices into the node coordinates ``x``) of a debonded interface."""
+
+def contact_pairs(
+    interface: str, nodes: np.ndarray, x: np.ndarray, width: float, *, search: str = "same-x",
+    reach: float = DEFAULT_REACH,
+) -> ContactPairs:
+    """Pairs at ``nodes`` (indices into the node coordinates ``x``) of a debonded interface.
+
+    ``search`` is ``"same-x"`` (the face node against the core point of the same x) or
+    ``"closest-point"`` (the face node projected on the core boundary curve, searched over the
+    segments within ``reach`` mm on each side of the node, at least one segment per side).
+    """
     if interface not in CONTACT_DOFS:
         raise ValueError(f"interface must be 'top' or 'bottom', got {interface!r}")
+    if search not in SEARCHES:
+        raise ValueError(f"contact search must be one of {SEARCHES}, got {search!r}")
+    x = np.asarray(x, dtype=float)
     nodes = np.asarray(nodes, dtype=int)
     left = np.where(nodes > 0, x[nodes] - x[np.maximum(nodes - 1, 0)], 0.0)
     right = np.where(nodes < x.size - 1, x[np.minimum(nodes + 1, x.size - 1)] - x[nodes], 0.0)
     names = CONTACT_DOFS[interface]
     dofs = np.stack([global_dof(nodes, names[r]) for r in PAIR_ROLES], axis=-1).reshape(-1, 6)
-    return ContactPairs(interface, nodes, width * 0.5 * (left + right), dofs)
+    area = width * 0.5 * (left + right)
+    if search == "same-x":
+        return ContactPairs(interface, nodes, area, dofs)
+    if not (np.isfinite(reach) and reach >= 0):
+        raise ValueError(f"contact reach must be >= 0 mm, got {reach!r}")
+    # Each node searches the core nodes lo..hi: the segments covering `reach` mm on each side
+    # (at least one segment per side, stopping at the mesh ends). A common width 2k + 1 keeps the
+    # arrays rectangular; slots beyond a node's own range repeat its end node (no extra coupling
+    # in the sparse pattern) and their segments are marked invalid.
+    tol = 1e-12 * (x[-1] - x[0])
+    lo = np.searchsorted(x, x[nodes] - reach + tol, side="right") - 1
+    lo = np.clip(np.minimum(lo, nodes - 1), 0, None)
+    hi = np.searchsorted(x, x[nodes] + reach - tol, side="left")
+    hi = np.clip(np.maximum(hi, nodes + 1), None, x.size - 1)
+    k = int(max(np.max(nodes - lo, initial=1), np.max(hi - nodes, initial=1)))
+    raw = nodes[:, None] + np.arange(-k, k + 1)[None, :]
+    core_nodes = np.clip(raw, lo[:, None], hi[:, None])
+    valid = (raw[:, :-1] >= lo[:, None]) & (raw[:, 1:] <= hi[:, None])
+    core = np.stack([global_dof(core_nodes, names[r]) for r in CORE_NODE_ROLES], axis=-1)
+    support = np.concatenate([dofs[:, :2], core.reshape(nodes.size, -1)], axis=1)
+    return ContactPairs(interface, nodes, area, dofs, search, x, core_nodes, valid, support)
 
 
 @dataclass(frozen=True)
 class PairKinematics:
-    """Gap g, its gradient and Hessian on the pair DOFs, and the tangential sliding."""
+    """Gap g, its gradient and Hessian on the pair's block DOFs, and the tangential sliding."""
 
     gap: np.ndarray  # (m,) mm, negative = penetration
-    grad: np.ndarray  # (m, 6)
-    hess: np.ndarray  # (m, 6, 6)
+    grad: np.ndarray  # (m, n) on ContactPairs.block_dofs
+    hess: np.ndarray  # (m, n, n)
     sliding: np.ndarray  # (m,) mm
+    xi: np.ndarray | None = None  # (m,) closest point's coordinate on its segment, [0, 1]
+    segment: np.ndarray | None = None  # (m,) chosen segment (local index)
+    outside: np.ndarray | None = None  # (m,) bool: no searched segment holds the projection
+
+
+def _gap_derivatives(
+    r1: np.ndarray, r2: np.ndarray, a: np.ndarray, c: np.ndarray, s_n: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gap g = s_n (a r2 − c r1)/√(a² + c²) with gradient and Hessian in (r1, r2, a, c)."""
+    ℓ = np.sqrt(a**2 + c**2)
+    q = -c * r1 + a * r2  # ℓ n·r / s_n
+    z = np.zeros_like(ℓ)
+    dq = np.stack([-c, a, r2, -r1], axis=-1)
+    dℓ = np.stack([z, z, a / ℓ, c / ℓ], axis=-1)
+    d2q = np.zeros((*ℓ.shape, 4, 4))
+    d2q[..., 0, 3] = d2q[..., 3, 0] = -1.0
+    d2q[..., 1, 2] = d2q[..., 2, 1] = 1.0
+    d2ℓ = np.zeros((*ℓ.shape, 4, 4))
+    d2ℓ[..., 2, 2], d2ℓ[..., 3, 3] = c**2 / ℓ**3, a**2 / ℓ**3
+    d2ℓ[..., 2, 3] = d2ℓ[..., 3, 2] = -a * c / ℓ**3
+    ℓ1, q1 = ℓ[..., None], q[..., None]
+    dg = s_n * (dq / ℓ1 - q1 * dℓ / ℓ1**2)
+    cross = dq[..., :, None] * dℓ[..., None, :]
+    d2g = s_n * (
+        d2q / ℓ1[..., None]
+        - (cross + np.swapaxes(cross, -1, -2)) / (ℓ1**2)[..., None]
+        - (q1 / ℓ1**2)[..., None] * d2ℓ
+        + (2 * q1 / ℓ1**3)[..., None] * dℓ[..., :, None] * dℓ[..., None, :]
+    )
+    return s_n * q / ℓ, dg, d2g
 
 
 def pair_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
     """Gap along the slave's deformed normal, eq. (42), with first and second derivatives."""
+    if pairs.search == "closest-point":
+        # the model asks for the force, then the tangent, at the same u: reuse the projection
+        v = u_full[pairs.support_dofs]
+        cached = getattr(pairs, "_last", None)
+        if cached is not None and np.array_equal(cached[0], v):
+            return cached[1]
+        k = _closest_point_kinematics(pairs, u_full)
+        object.__setattr__(pairs, "_last", (v, k))
+        return k
     v = u_full[pairs.dofs]  # (m, 6)
     Δu, Δw = v[:, 0] - v[:, 2], v[:, 1] - v[:, 3]
     a, c = 1.0 + v[:, 4], v[:, 5]  # slave tangent (1 + u_c,x, w_c,x)
-    ℓ = np.sqrt(a**2 + c**2)
-    s_n = NORMAL_SIGN[pairs.interface]
-    q = -c * Δu + a * Δw  # ℓ n·Δ / s_n
-    gap = s_n * q / ℓ  # eq. (42): w̄_face − w̄_core
-    sliding = (a * Δu + c * Δw) / ℓ
-    m = v.shape[0]
-    # Derivatives in the variables (Δu, Δw, a, c).
-    dq = np.stack([-c, a, Δw, -Δu], axis=-1)
-    dℓ = np.stack([np.zeros(m), np.zeros(m), a / ℓ, c / ℓ], axis=-1)
-    d2q = np.zeros((m, 4, 4))
-    d2q[:, 0, 3] = d2q[:, 3, 0] = -1.0
-    d2q[:, 1, 2] = d2q[:, 2, 1] = 1.0
-    d2ℓ = np.zeros((m, 4, 4))
-    d2ℓ[:, 2, 2], d2ℓ[:, 3, 3] = c**2 / ℓ**3, a**2 / ℓ**3
-    d2ℓ[:, 2, 3] = d2ℓ[:, 3, 2] = -a * c / ℓ**3
-    ℓ1, q1 = ℓ[:, None], q[:, None]
-    dg = s_n * (dq / ℓ1 - q1 * dℓ / ℓ1**2)
-    cross = dq[:, :, None] * dℓ[:, None, :]
-    d2g = s_n * (
-        d2q / ℓ1[:, :, None]
-        - (cross + cross.transpose(0, 2, 1)) / (ℓ1**2)[:, :, None]
-        - (q1 / ℓ1**2)[:, :, None] * d2ℓ
-        + (2 * q1 / ℓ1**3)[:, :, None] * dℓ[:, :, None] * dℓ[:, None, :]
-    )
+    gap, dg, d2g = _gap_derivatives(Δu, Δw, a, c, NORMAL_SIGN[pairs.interface])
+    sliding = (a * Δu + c * Δw) / np.sqrt(a**2 + c**2)
     return PairKinematics(gap, dg @ _D, np.einsum("ia,mij,jb->mab", _D, d2g, _D), sliding)
+
+
+def hermite_basis(xi: np.ndarray, length: np.ndarray, orders: int = 4) -> np.ndarray:
+    """Cubic Hermite functions on a segment, ξ ∈ [0, 1], and their ξ-derivatives 0 … orders − 1.
+
+    Returns (orders, …, 4): derivative order × the functions multiplying (value at node a, slope
+    at a, value at b, slope at b) with the slopes physical (d/dx), i.e. the slope functions carry
+    the segment length. These are the element's ``"H"``/``"Hbar"`` x-functions of
+    :mod:`beam_element.shape_functions` with η = 2ξ − 1 (checked in the tests).
+    """
+    ξ = np.asarray(xi, dtype=float)
+    l = np.broadcast_to(np.asarray(length, dtype=float), ξ.shape)
+    ξ2 = ξ * ξ
+    ξ3 = ξ2 * ξ
+    out = np.empty((orders, *ξ.shape, 4))
+    out[0, ..., 0] = 1 - 3 * ξ2 + 2 * ξ3
+    out[0, ..., 1] = l * (ξ - 2 * ξ2 + ξ3)
+    out[0, ..., 2] = 3 * ξ2 - 2 * ξ3
+    out[0, ..., 3] = l * (ξ3 - ξ2)
+    if orders > 1:
+        out[1, ..., 0] = 6 * (ξ2 - ξ)
+        out[1, ..., 1] = l * (1 - 4 * ξ + 3 * ξ2)
+        out[1, ..., 2] = -out[1, ..., 0]
+        out[1, ..., 3] = l * (3 * ξ2 - 2 * ξ)
+    if orders > 2:
+        out[2, ..., 0] = 12 * ξ - 6
+        out[2, ..., 1] = l * (6 * ξ - 4)
+        out[2, ..., 2] = -out[2, ..., 0]
+        out[2, ..., 3] = l * (6 * ξ - 2)
+    if orders > 3:
+        out[3, ..., 0], out[3, ..., 2] = 12.0, -12.0
+        out[3, ..., 1] = out[3, ..., 3] = 6 * l
+    return out
+
+
+def _segment_geometry(pairs: ContactPairs, u_full: np.ndarray):
+    """Per pair and candidate segment: ends, length, nodal (U, W) and the master's point."""
+    x = pairs.x
+    v_face = u_full[pairs.dofs[:, :2]]  # (m, 2): u_face, w_face
+    core = u_full[pairs.support_dofs[:, 2:]].reshape(pairs.size, -1, 4)  # (m, n_c, 4)
+    xa, xb = x[pairs.core_nodes[:, :-1]], x[pairs.core_nodes[:, 1:]]
+    length = np.where(pairs.segment_valid, xb - xa, 1.0)
+    # U = (u_a, u_a,x, u_b, u_b,x), W = (w_a, w_a,x, w_b, w_b,x) per segment
+    U = np.concatenate([core[:, :-1, 0:2], core[:, 1:, 0:2]], axis=-1)
+    W = np.concatenate([core[:, :-1, 2:4], core[:, 1:, 2:4]], axis=-1)
+    xs = x[pairs.nodes][:, None] + v_face[:, 0:1]  # master point, x (the z offsets cancel)
+    return xa, length, U, W, xs, v_face[:, 1:2]
+
+
+def _closest_point_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
+    m = pairs.size
+    xa, l, U, W, xs, ws = _segment_geometry(pairs, u_full)
+    x_node = pairs.x[pairs.nodes][:, None]
+    # Newton for φ(ξ) = r·X_ξ = 0 on every candidate segment, from the node's own x (clamped)
+    ξ = np.clip((x_node - xa) / l, 0.0, 1.0)
+    for _ in range(PROJECTION_MAX_ITERATIONS):
+        N = hermite_basis(ξ, l, orders=3)  # (3, m, s, 4)
+        r1 = xs - (xa + l * ξ + np.sum(N[0] * U, -1))
+        r2 = ws - np.sum(N[0] * W, -1)
+        a, c = l + np.sum(N[1] * U, -1), np.sum(N[1] * W, -1)
+        aξ, cξ = np.sum(N[2] * U, -1), np.sum(N[2] * W, -1)
+        φ = r1 * a + r2 * c
+        φξ = -(a**2 + c**2) + r1 * aξ + r2 * cξ
+        φξ = np.where(φξ < -1e-3 * (a**2 + c**2), φξ, -(a**2 + c**2))  # keep the descent
+        new = np.clip(ξ + np.clip(-φ / φξ, -0.5, 0.5), -0.5, 1.5)
+        change = np.max(np.abs(new - ξ), initial=0.0)
+        ξ = new
+        if change < PROJECTION_TOL:
+            break
+    # choose: a segment holding its projection, the nearest if several; else the least outside
+    inside = pairs.segment_valid & (ξ >= -IN_SEGMENT_TOL) & (ξ <= 1 + IN_SEGMENT_TOL)
+    N = hermite_basis(ξ, l, orders=1)
+    r1 = xs - (xa + l * ξ + np.sum(N[0] * U, -1))
+    r2 = ws - np.sum(N[0] * W, -1)
+    dist = np.hypot(r1, r2)
+    out_by = np.where(pairs.segment_valid, l * np.maximum(np.maximum(-ξ, ξ - 1), 0.0), np.inf)
+    score = np.where(inside, dist, np.inf)
+    outside = ~inside.any(axis=1)
+    seg = np.where(outside, np.argmin(out_by, axis=1), np.argmin(score, axis=1))
+    rows = np.arange(m)
+    ξs, ls, Us, Ws = ξ[rows, seg], l[rows, seg], U[rows, seg], W[rows, seg]
+    N = hermite_basis(ξs, ls)  # (4, m, 4)
+    r1 = xs[:, 0] - (xa[rows, seg] + ls * ξs + np.sum(N[0] * Us, -1))
+    r2 = ws[:, 0] - np.sum(N[0] * Ws, -1)
+    a, c = ls + np.sum(N[1] * Us, -1), np.sum(N[1] * Ws, -1)
+    aξ, cξ = np.sum(N[2] * Us, -1), np.sum(N[2] * Ws, -1)
+    aξξ, cξξ = np.sum(N[3] * Us, -1), np.sum(N[3] * Ws, -1)
+    s_n = NORMAL_SIGN[pairs.interface]
+    gap, dg, d2g = _gap_derivatives(r1, r2, a, c, s_n)
+    # Variables y = (ξ, u_f, w_f, U0..U3, W0..W3); J = ∂(r1, r2, a, c)/∂y, Z_α = ∂²(·)_α/∂y²:
+    # ∂²r/∂ξ² = −X_ξξ, ∂²r/∂ξ∂(U, W) = −N', ∂²X_ξ/∂ξ² = X_ξξξ, ∂²X_ξ/∂ξ∂(U, W) = N''.
+    J = np.zeros((m, 4, 11))
+    J[:, 0, 0], J[:, 0, 1], J[:, 0, 3:7] = -a, 1.0, -N[0]
+    J[:, 1, 0], J[:, 1, 2], J[:, 1, 7:11] = -c, 1.0, -N[0]
+    J[:, 2, 0], J[:, 2, 3:7] = aξ, N[1]
+    J[:, 3, 0], J[:, 3, 7:11] = cξ, N[1]
+    # Σ_α g̃_α Z_α: only the ξ row and column are non-zero
+    Zg = np.zeros((m, 11, 11))
+    Zg[:, 0, 0] = -dg[:, 0] * aξ - dg[:, 1] * cξ + dg[:, 2] * aξξ + dg[:, 3] * cξξ
+    Zg[:, 0, 3:7] = -dg[:, 0, None] * N[1] + dg[:, 2, None] * N[2]
+    Zg[:, 0, 7:11] = -dg[:, 1, None] * N[1] + dg[:, 3, None] * N[2]
+    Zg[:, 1:, 0] = Zg[:, 0, 1:]
+    Jt = J.transpose(0, 2, 1)
+    G = (dg[:, None, :] @ J)[:, 0]  # ∂g̃/∂y
+    H = Jt @ d2g @ J + Zg
+    dφ = np.stack([a, c, r1, r2], axis=-1)  # ∂φ/∂(r1, r2, a, c), φ = r1 a + r2 c
+    Φ = (dφ[:, None, :] @ J)[:, 0]
+    ξq = -Φ[:, 1:] / Φ[:, :1]  # dξ/dq from φ(ξ(q), q) = 0
+    grad = G[:, 1:]  # + g̃_ξ ξ_q, zero at the projection (g̃_ξ = s_n r·n_ξ ∝ φ)
+    hess = (H[:, 1:, 1:] + H[:, 1:, :1] * ξq[:, None, :] + ξq[:, :, None] * H[:, :1, 1:]
+            + H[:, :1, :1] * ξq[:, :, None] * ξq[:, None, :])
+    # scatter the segment's 10 DOFs into the pair's block
+    base = 2 + 4 * seg[:, None]
+    cols = np.concatenate([np.zeros((m, 1), int), np.ones((m, 1), int),
+                           base + np.array([0, 1, 4, 5]), base + np.array([2, 3, 6, 7])], axis=1)
+    n = pairs.support_dofs.shape[1]
+    g_full = np.zeros((m, n))
+    h_full = np.zeros((m, n, n))
+    g_full[rows[:, None], cols] = grad
+    h_full[rows[:, None, None], cols[:, :, None], cols[:, None, :]] = hess
+    sliding = xa[rows, seg] + ls * ξs - x_node[:, 0]
+    return PairKinematics(gap, g_full, h_full, sliding, ξs, seg, outside)
 
 
 SHIFT = 25.0  # c: the softplus is centred at g = −c s, so dp/dg jumps by only ε e⁻²⁵ at g = 0
@@ -167,10 +408,16 @@ def _softplus(x: np.ndarray | float) -> np.ndarray:
 
 
 def _softplus_integral(x: np.ndarray | float) -> np.ndarray:
-    """∫_−∞^x ln(1 + eᵗ) dt = −Li₂(−eˣ), with Li₂(z) = ``scipy.special.spence(1 − z)``."""
+    """∫_−∞^x ln(1 + eᵗ) dt = −Li₂(−eˣ), with Li₂(z) = ``scipy.special.spence(1 − z)``.
+
+    For x > 0 the inversion formula −Li₂(−eˣ) = π²/6 + x²/2 + Li₂(−e⁻ˣ) avoids overflowing eˣ.
+    """
     from scipy.special import spence
 
-    return -spence(1.0 + np.exp(x))
+    x = np.asarray(x, dtype=float)
+    a = np.abs(x)
+    low = -spence(1.0 + np.exp(-a))  # the integral at −|x|
+    return np.where(x > 0, np.pi**2 / 6 + 0.5 * a**2 - low, low)
 
 
 def contact_energy(gap: np.ndarray, penalty: float, smoothing: float = 0.0) -> np.ndarray:

@@ -1,0 +1,286 @@
+"""Closest-point (node-to-segment) contact of beam_element.contact (issue #3).
+
+References, test by test:
+
+- the core boundary curve is rebuilt here from the element's own x shape functions
+  (``beam_element.shape_functions.x_shape``, eq. 11a), not from ``contact.hermite_basis``;
+- known closest points: a face node is put at X(s) + g n(s), n the curve's deformed outward normal
+  at a chosen material point s; r = g n is normal to the curve there, so the exact gap is g and
+  the exact (material) sliding s − x_i;
+- derivatives: central finite differences of the code's own gap, force and energy;
+- zero sliding: the same-x gap (eq. 42, its derivatives are checked in test_beam_tangent.py);
+- a real scene (fig. 5): the issue's bound, penetration ≤ 1e-3 × face thickness.
+"""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beam_element import run
+from beam_element.contact import (
+    NORMAL_SIGN,
+    contact_energy,
+    contact_pairs,
+    hermite_basis,
+    pair_kinematics,
+    penalty_response,
+)
+from beam_element.dofs import CONTACT_DOFS, NODE_DOFS, global_dof
+from beam_element.model import build_model
+from beam_element.shape_functions import x_shape
+from sandwich.scene import load_scene
+
+EPS = 2.24e4  # N/mm³, the default penalty for the paper's Rohacell core
+S = 1e-6  # mm, the default regularisation width for 0.5 mm faces
+X = np.array([0.0, 2.0, 3.0, 4.5, 5.0, 6.5, 8.0, 10.0])  # graded-like, unequal elements
+NODES = np.arange(1, 7)  # untied nodes: all but the ends
+FIG5 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
+
+
+def _core_fields(theta, amp):
+    """Core boundary (u, u', w, w'): a rigid rotation θ about x = 0 plus a smooth wave."""
+    L = X[-1]
+
+    def fields(x):
+        k = np.pi / L
+        u = (np.cos(theta) - 1.0) * x + 0.3 * amp * np.cos(2 * k * x)
+        ux = (np.cos(theta) - 1.0) - 0.6 * amp * k * np.sin(2 * k * x)
+        w = np.sin(theta) * x + amp * np.sin(k * x)
+        wx = np.sin(theta) + amp * k * np.cos(k * x)
+        return u, ux, w, wx
+
+    return fields
+
+
+def _curve(x_nodes, nodal, s):
+    """Deformed core boundary at material point s from the element's x_shape (eq. 11a).
+
+    ``nodal`` is (n, 4): u, u_x, w, w_x per node. Returns the point (x + u, w) and the tangent
+    (1 + u_x, w_x).
+    """
+    e = int(np.clip(np.searchsorted(x_nodes, s, side="right") - 1, 0, x_nodes.size - 2))
+    l = x_nodes[e + 1] - x_nodes[e]
+    η = 2.0 * (s - x_nodes[e]) / l - 1.0
+    val = np.zeros(2)
+    der = np.zeros(2)
+    for a in (0, 1):
+        H, dH = x_shape("H", a, η)
+        B, dB = x_shape("Hbar", a, η)
+        u, ux, w, wx = nodal[e + a]
+        val += [H * u + 0.5 * l * B * ux, H * w + 0.5 * l * B * wx]
+        der += (2.0 / l) * np.array([dH * u + 0.5 * l * dB * ux, dH * w + 0.5 * l * dB * wx])
+    return np.array([s + val[0], val[1]]), np.array([1.0 + der[0], der[1]])
+
+
+def _state(interface, slide, gap, theta=0.3, amp=0.4):
+    """Full DOF vector: core boundary from _core_fields, face node i at X(x_i + d_i) + g_i n."""
+    u = np.zeros(NODE_DOFS * X.size)
+    names = CONTACT_DOFS[interface]
+    nodal = np.stack(_core_fields(theta, amp)(X), axis=-1)
+    for role, j in (("u_core", 0), ("u_core,x", 1), ("w_core", 2), ("w_core,x", 3)):
+        u[global_dof(np.arange(X.size), names[role])] = nodal[:, j]
+    s_n = NORMAL_SIGN[interface]
+    for i, d, g in zip(NODES, slide, gap, strict=True):
+        point, t = _curve(X, nodal, X[i] + d)
+        n = s_n * np.array([-t[1], t[0]]) / np.hypot(*t)
+        face = point + g * n
+        u[global_dof(i, names["u_face"])] = face[0] - X[i]
+        u[global_dof(i, names["w_face"])] = face[1]
+    return u
+
+
+def _global(pairs, m, local):
+    """A pair's block vector (n,) or matrix (n, n) on the full DOFs (repeated DOFs summed)."""
+    d = pairs.block_dofs[m]
+    n = NODE_DOFS * X.size
+    if local.ndim == 1:
+        return np.bincount(d, weights=local, minlength=n)
+    out = np.zeros((n, n))
+    np.add.at(out, (d[:, None], d[None, :]), local)
+    return out
+
+
+def _pairs(interface, reach=2.0):
+    return contact_pairs(interface, NODES, X, 60.0, search="closest-point", reach=reach)
+
+
+def test_hermite_basis_is_the_element_x_interpolation():
+    l = 1.7
+    ξ = np.linspace(0.0, 1.0, 7)
+    η = 2 * ξ - 1
+    N = hermite_basis(ξ, np.full_like(ξ, l))
+    ref = [x_shape("H", 0, η), x_shape("Hbar", 0, η), x_shape("H", 1, η), x_shape("Hbar", 1, η)]
+    scale = [1.0, l / 2, 1.0, l / 2]  # the slope functions multiply (l/2) u,x (reference length 2)
+    for k in range(4):
+        assert np.allclose(N[0][:, k], scale[k] * ref[k][0], atol=1e-14)
+        assert np.allclose(N[1][:, k], 2 * scale[k] * ref[k][1], atol=1e-14)  # d/dξ = 2 d/dη
+    # second and third derivatives: central differences of the first
+    h = 1e-6
+    Np, Nm = hermite_basis(ξ + h, np.full_like(ξ, l)), hermite_basis(ξ - h, np.full_like(ξ, l))
+    assert np.allclose(N[2], (Np[1] - Nm[1]) / (2 * h), atol=1e-7)
+    assert np.allclose(N[3], (Np[2] - Nm[2]) / (2 * h), atol=1e-7)
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_known_closest_point_including_crossing_into_next_segments(interface):
+    # slides as fractions of the local elements; node 3 (x = 4.5) slides past node 4 (x = 5)
+    # into the segment [5, 6.5], node 4 back past node 3 into [3, 4.5]
+    slide = np.array([0.6, -0.45, 0.8, -0.9, 0.0, 1.3])
+    gap = np.array([-2e-3, -1e-4, -3e-2, 5e-3, -1e-3, -1e-2])
+    pairs = _pairs(interface)
+    u = _state(interface, slide, gap)
+    k = pair_kinematics(pairs, u)
+    assert not k.outside.any()
+    assert np.allclose(k.gap, gap, rtol=0, atol=1e-12)
+    assert np.allclose(k.sliding, slide, rtol=0, atol=1e-11)
+    # the chosen segment holds the material point x_i + d_i
+    seg_nodes = pairs.core_nodes[np.arange(pairs.size), k.segment]
+    left = X[seg_nodes]
+    target = X[NODES] + slide
+    assert np.all((left <= target + 1e-12) & (target <= X[seg_nodes + 1] + 1e-12))
+    assert np.allclose(left + k.xi * (X[seg_nodes + 1] - left), target, atol=1e-11)
+    # crossings: node 3 ends in [5, 6.5] (two segments to the right), node 4 in [3, 4.5]
+    assert list(X[seg_nodes[2:4]]) == [5.0, 3.0]
+
+
+def test_gap_and_force_continuous_when_the_projection_crosses_a_node():
+    # node 2 (x = 3) slides through node 3 (x = 4.5): the segment switches at d = 1.5
+    pairs = _pairs("top")
+    forces, segs = [], []
+    for d in (1.5 - 1e-9, 1.5 + 1e-9):
+        slide = np.array([0.0, d, 0.0, 0.0, 0.0, 0.0])
+        u = _state("top", slide, np.full(6, -1e-3))
+        f, _, _, k = penalty_response(pairs, u, EPS, S)
+        forces.append(_global(pairs, 1, f[1]))
+        segs.append(int(pairs.core_nodes[1, k.segment[1]]))
+    assert segs == [2, 3]  # [3, 4.5] then [4.5, 5]
+    assert np.linalg.norm(forces[1] - forces[0]) < 1e-6 * np.linalg.norm(forces[0])
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_zero_sliding_gives_the_same_x_gap(interface):
+    gap = np.array([-2e-3, -1e-4, 3e-2, -5e-3, -1e-3, 0.2])
+    u = _state(interface, np.zeros(6), gap, theta=-0.2, amp=0.7)
+    closest, same_x = _pairs(interface), contact_pairs(interface, NODES, X, 60.0)
+    kc, ks = pair_kinematics(closest, u), pair_kinematics(same_x, u)
+    assert np.allclose(ks.gap, gap, atol=1e-12)  # the construction, seen by the same-x gap
+    assert np.allclose(kc.gap, ks.gap, rtol=0, atol=1e-13)
+    assert np.allclose(kc.sliding, 0.0, atol=1e-12) and np.allclose(ks.sliding, 0.0, atol=1e-12)
+    for m in range(closest.size):
+        gc = _global(closest, m, kc.grad[m])
+        gs = np.bincount(same_x.dofs[m], weights=ks.grad[m], minlength=u.size)
+        assert np.allclose(gc, gs, rtol=0, atol=1e-12)
+
+
+def _fixed_point_gap(interface, u, i, s):
+    """Gap to the curve point at fixed material coordinate s (no projection): for contrast."""
+    names = CONTACT_DOFS[interface]
+    nodal = np.stack([u[global_dof(np.arange(X.size), names[r])]
+                      for r in ("u_core", "u_core,x", "w_core", "w_core,x")], axis=-1)
+    point, t = _curve(X, nodal, s)
+    face = np.array([X[i] + u[global_dof(i, names["u_face"])], u[global_dof(i, names["w_face"])]])
+    n = NORMAL_SIGN[interface] * np.array([-t[1], t[0]]) / np.hypot(*t)
+    return n @ (face - point)
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_consistent_tangent_with_sliding_and_rotation(interface):
+    # rotation 0.3 rad, a bending wave, slides 0.3-0.45 of an element (both directions, one past
+    # a node), penetrations deep enough that the geometric term p A ∂²g matters
+    slide = np.array([0.7, -0.35, 0.6, -0.2, 0.5, -0.6])
+    gap = np.array([-2e-2, -1e-2, -3e-2, -1.5e-2, -2.5e-2, -1e-2])
+    pairs = _pairs(interface)
+    u = _state(interface, slide, gap)
+    f, K, p, k = penalty_response(pairs, u, EPS, S)
+    assert np.all(p > 0) and not k.outside.any()
+    h = 1e-6
+    for m in range(pairs.size):
+        dofs = np.unique(pairs.block_dofs[m])
+        G, H = _global(pairs, m, k.grad[m]), _global(pairs, m, k.hess[m])
+        F, KK = _global(pairs, m, f[m]), _global(pairs, m, K[m])
+        fd_g, fd_G, fd_F, fd_W = (np.zeros(u.size), np.zeros((u.size, u.size)),
+                                  np.zeros((u.size, u.size)), np.zeros(u.size))
+        for j in dofs:
+            du = np.zeros_like(u)
+            du[j] = h
+            fp, _, _, kp = penalty_response(pairs, u + du, EPS, S)
+            fm, _, _, km = penalty_response(pairs, u - du, EPS, S)
+            fd_g[j] = (kp.gap[m] - km.gap[m]) / (2 * h)
+            fd_G[:, j] = (_global(pairs, m, kp.grad[m]) - _global(pairs, m, km.grad[m])) / (2 * h)
+            fd_F[:, j] = (_global(pairs, m, fp[m]) - _global(pairs, m, fm[m])) / (2 * h)
+            fd_W[j] = pairs.area[m] * (contact_energy(kp.gap[m], EPS, S)
+                                       - contact_energy(km.gap[m], EPS, S)) / (2 * h)
+        assert np.allclose(G, fd_g, rtol=0, atol=1e-8 * np.abs(G).max())
+        assert np.allclose(H, fd_G, rtol=0, atol=1e-6 * np.abs(H).max())
+        assert np.allclose(F, fd_W, rtol=0, atol=1e-6 * np.abs(F).max())  # f = ∂W/∂u
+        assert np.allclose(KK, fd_F, rtol=0, atol=1e-6 * np.abs(KK).max())
+        assert np.max(np.abs(KK - KK.T)) < 1e-10 * np.abs(KK).max()
+        # contrast: the Hessian of the gap at a frozen curve point differs by far more than the
+        # tolerance above, so the check sees the dependence of ξ on the displacements
+        i, s = NODES[m], X[NODES[m]] + k.sliding[m]
+        sub = dofs
+        Hf = np.zeros((sub.size, sub.size))
+        hh = 1e-4
+        for a, ja in enumerate(sub):
+            for b, jb in enumerate(sub):
+                e_a, e_b = np.zeros_like(u), np.zeros_like(u)
+                e_a[ja], e_b[jb] = hh, hh
+                Hf[a, b] = (_fixed_point_gap(interface, u + e_a + e_b, i, s)
+                            - _fixed_point_gap(interface, u + e_a - e_b, i, s)
+                            - _fixed_point_gap(interface, u - e_a + e_b, i, s)
+                            + _fixed_point_gap(interface, u - e_a - e_b, i, s)) / (4 * hh**2)
+        assert np.abs(Hf - H[np.ix_(sub, sub)]).max() > 1e-3 * np.abs(H).max()
+
+
+def test_contact_search_option_and_its_validation():
+    scene = load_scene(FIG5)
+    same = build_model(scene, elements=40)  # the default
+    closest = build_model(scene, elements=40, contact_search="closest-point")
+    assert [p.search for p in same.pairs] == ["same-x"]
+    assert [p.search for p in closest.pairs] == ["closest-point"]
+    assert np.array_equal(same.pairs[0].nodes, closest.pairs[0].nodes)
+    assert same.pairs[0].block_dofs.shape[1] == 6
+    with pytest.raises(ValueError, match="contact search"):
+        build_model(scene, elements=40, contact_search="nearest")
+
+
+def test_fig5_converged_states_respect_the_penetration_bound():
+    scene = load_scene(FIG5)
+    scene = dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
+                                                                    until_value=-4.0))
+    result = run(scene, elements=60, model_options={"contact_search": "closest-point"})
+    model = result.model
+    assert result.solution.converged, result.solution.message
+    assert [p.search for p in model.pairs] == ["closest-point"]
+    bound = model.penetration_bound()
+    assert bound == pytest.approx(5e-4)  # 1e-3 × 0.5 mm faces
+    summaries = [model.contact_summary(s.u)["top"] for s in result.states[1:]]
+    assert max(c.max_penetration for c in summaries) <= bound
+    assert summaries[-1].active > 0 and summaries[-1].max_sliding > 0
+    k = pair_kinematics(model.pairs[0], model.expand(result.states[-1].u))
+    assert not k.outside.any()
+
+
+def test_consistent_tangent_with_sliding_inside_the_smoothing_band():
+    # gaps where the regularised stiffness changes most (g ≈ −c s, contact_law tests the law);
+    # the pairs slide 0.2-0.7 of an element, so the projection moves with the step as well
+    slide = np.array([0.7, -0.35, 0.6, -0.2, 0.5, -0.6])
+    gap = -25.0 * S * np.array([0.6, 0.9, 1.0, 1.1, 1.2, 1.4])
+    pairs = _pairs("top")
+    u = _state("top", slide, gap)
+    f, K, _, k = penalty_response(pairs, u, EPS, S)
+    assert np.allclose(k.gap, gap, rtol=0, atol=1e-12)
+    # step 1e-3 s: the positions here are ~3 mm (rotation), so the gap carries a round-off of
+    # ~1e-15 mm and smaller steps lose digits (1e-4 s: 4e-6 of max|K|); the law varies over ~s
+    h = 1e-3 * S
+    for m in range(pairs.size):
+        dofs = np.unique(pairs.block_dofs[m])
+        KK = _global(pairs, m, K[m])
+        for j in dofs:
+            du = np.zeros_like(u)
+            du[j] = h
+            fd = (_global(pairs, m, penalty_response(pairs, u + du, EPS, S)[0][m])
+                  - _global(pairs, m, penalty_response(pairs, u - du, EPS, S)[0][m])) / (2 * h)
+            assert np.allclose(KK[:, j], fd, rtol=1e-5, atol=1e-6 * np.abs(KK).max())
