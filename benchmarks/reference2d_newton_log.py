@@ -46,6 +46,11 @@ def active_set(system) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(flags), np.concatenate(gaps)
 
 
+def slave_x(system) -> np.ndarray:
+    """Reference x of every slave (all pairs, in the order of :func:`active_set`)."""
+    return np.concatenate([p.x_ref for p in system.contacts])
+
+
 def newton_log(system, u_n: np.ndarray, lam: float, dlam: float, max_iterations: int,
                floor: float, predictor: bool = True) -> list[dict]:
     """Full Newton at λ = lam + dlam from u_n (+ tangent predictor); one dict per iterate.
@@ -60,16 +65,21 @@ def newton_log(system, u_n: np.ndarray, lam: float, dlam: float, max_iterations:
         u = u + dlam * system.factorize(system.tangent(u_n)).solve(f_ref)
     scale = system.norm(target * f_ref)
     rows, prev_flags, du_norm = [], None, math.nan
+    xs = slave_x(system)
     for it in range(max_iterations + 1):
         r = system.internal_force(u) - target * f_ref
         system.commit(u, target)  # (stores the contact state of u; penalty contact: no history)
         flags, gaps = active_set(system)
         changed = int(np.sum(flags != prev_flags)) if prev_flags is not None else None
+        changed_x = ([f"{x:g}{'+' if a else '-'}" for x, a in
+                      zip(xs[flags != prev_flags], flags[flags != prev_flags], strict=True)]
+                     if prev_flags is not None else [])
         prev_flags = flags
         norm = system.norm(r)
         inactive_near = np.abs(gaps[~flags]) if np.any(~flags) else np.array([np.inf])
         rows.append({"iteration": it, "residual": norm, "relative": norm / scale,
                      "du": du_norm, "active": int(flags.sum()), "changed": changed,
+                     "changed_at_x": changed_x,
                      "smallest_active_penetration": float(np.min(-gaps[flags]))
                      if flags.any() else None,
                      "smallest_open_gap": float(inactive_near.min())})
@@ -94,11 +104,13 @@ def fmt(x, spec):
 
 
 def md_table(rows: list[dict]) -> list[str]:
-    out = ["| it | ‖R‖ (N) | ‖R‖/‖λ f_ref‖ | ‖δu‖ before (mm) | active lip nodes | changed | "
-           "‖R_k‖/‖R_k-1‖² | order |", "|" + "---|" * 8]
+    out = ["| it | ‖R‖ (N) | ‖R‖/‖λ f_ref‖ | ‖δu‖ before (mm) | active lip nodes | changed "
+           "(x in mm: + closed, − opened) | ‖R_k‖/‖R_k-1‖² (1/N) | order |", "|" + "---|" * 8]
     for r in rows:
+        where = " ".join(r["changed_at_x"][:6]) + (" …" if len(r["changed_at_x"]) > 6 else "")
         out.append(f"| {r['iteration']} | {r['residual']:.3e} | {r['relative']:.2e} | "
-                   f"{fmt(r['du'], '.2e')} | {r['active']} | {fmt(r['changed'], 'd')} | "
+                   f"{fmt(r['du'], '.2e')} | {r['active']} | {fmt(r['changed'], 'd')} "
+                   f"{'(' + where + ')' if where else ''} | "
                    f"{fmt(r['ratio_to_square'], '.2e')} | {fmt(r['order'], '.2f')} |")
     return out
 
