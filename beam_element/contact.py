@@ -196,6 +196,30 @@ def contact_pairs(
     return ContactPairs(interface, nodes, area, dofs, search, x, core_nodes, valid, support)
 
 
+def contact_pair_groups(
+    interface: str, nodes: np.ndarray, x: np.ndarray, width: float, *, search: str = "same-x",
+    reach: float = DEFAULT_REACH,
+) -> list[ContactPairs]:
+    """:func:`contact_pairs` split so that each group's blocks are no wider than needed.
+
+    A closest-point pair's block spans the core nodes within ``reach`` of its node, so on a
+    graded mesh the width varies node to node; one rectangular group would give every pair the
+    widest block. Nodes are grouped by their search half-width k rounded up to a power of two
+    (at most a few groups, each block at most twice its needed width). Same-x: one group.
+    """
+    x = np.asarray(x, dtype=float)
+    nodes = np.asarray(nodes, dtype=int)
+    if search != "closest-point" or nodes.size == 0:
+        return [contact_pairs(interface, nodes, x, width, search=search, reach=reach)]
+    k = np.ones(nodes.size, dtype=int)
+    for i in range(nodes.size):  # the half-width each node needs (as in contact_pairs)
+        k[i] = contact_pairs(interface, nodes[i:i + 1], x, width, search=search,
+                             reach=reach).core_nodes.shape[1] // 2
+    bins = 2 ** np.ceil(np.log2(k)).astype(int)
+    return [contact_pairs(interface, nodes[bins == b], x, width, search=search, reach=reach)
+            for b in np.unique(bins)]
+
+
 @dataclass(frozen=True)
 class PairKinematics:
     """Gap g, its gradient and Hessian on the pair's block DOFs, and the tangential sliding."""

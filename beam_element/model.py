@@ -20,7 +20,7 @@ from beam_element.constraints import DofMap, NodeSupport, build_dof_map
 from beam_element.contact import (
     DEFAULT_REACH,
     ContactPairs,
-    contact_pairs,
+    contact_pair_groups,
     in_contact,
     penalty_response,
 )
@@ -49,8 +49,9 @@ class ContactSummary:
 
     max_penetration: float = 0.0  # mm
     max_pressure: float = 0.0  # MPa
-    max_sliding: float = 0.0  # mm, |t·Δ| of pairs in contact
+    max_sliding: float = 0.0  # mm, of pairs in contact: |t·Δ| (same-x), |x(ξ) − x_i| (closest)
     active: int = 0  # pairs in contact
+    outside_reach: int = 0  # pairs in contact projecting beyond the searched segments
 
 
 @dataclass
@@ -184,16 +185,18 @@ class BeamModel:
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
         """Penetration, pressure and sliding per interface at free DOFs ``u``."""
         u_full = self.expand(u)
-        out = {}
-        for pairs in self.pairs:
+        out: dict[str, ContactSummary] = {}
+        for pairs in self.pairs:  # an interface may hold several groups (contact_pair_groups)
             _, _, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             active = in_contact(k.gap, self.smoothing)
-            out[pairs.interface] = ContactSummary(
-                max_penetration=float(np.max(-k.gap, initial=0.0)),
-                max_pressure=float(np.max(p, initial=0.0)),
-                max_sliding=float(np.max(np.abs(k.sliding[active]), initial=0.0)),
-                active=int(active.sum()),
-            )
+            c = out.setdefault(pairs.interface, ContactSummary())
+            c.max_penetration = max(c.max_penetration, float(np.max(-k.gap, initial=0.0)))
+            c.max_pressure = max(c.max_pressure, float(np.max(p, initial=0.0)))
+            c.max_sliding = max(c.max_sliding,
+                                float(np.max(np.abs(k.sliding[active]), initial=0.0)))
+            c.active += int(active.sum())
+            if k.outside is not None:
+                c.outside_reach += int(np.sum(k.outside & active))
         return out
 
     def penetration_bound(self) -> float:
@@ -329,9 +332,9 @@ def build_model(
             f_ref += patch_load(mesh, load.on, *load.span, load.force)
     probes = {p.name: probe_row(mesh, p.on, p.x) for p in scene.probes}
 
-    pairs = [contact_pairs(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width,
-                           search=contact_search, reach=contact_reach)
-             for i in ("top", "bottom") if np.any(~bonded[i])]
+    pairs = [group for i in ("top", "bottom") if np.any(~bonded[i])
+             for group in contact_pair_groups(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width,
+                                              search=contact_search, reach=contact_reach)]
     if contact_penalty is None:
         contact_penalty = getattr(options, "contact_penalty", None)
     if contact_penalty is None:

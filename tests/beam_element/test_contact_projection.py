@@ -259,6 +259,7 @@ def test_fig5_converged_states_respect_the_penetration_bound():
     summaries = [model.contact_summary(s.u)["top"] for s in result.states[1:]]
     assert max(c.max_penetration for c in summaries) <= bound
     assert summaries[-1].active > 0 and summaries[-1].max_sliding > 0
+    assert all(c.outside_reach == 0 for c in summaries)
     k = pair_kinematics(model.pairs[0], model.expand(result.states[-1].u))
     assert not k.outside.any()
 
