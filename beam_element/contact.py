@@ -95,6 +95,7 @@ disturbs the pressure there (squeeze test, 10 mm from the tip: +0.56 % at s = 1e
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -141,6 +142,10 @@ class ContactPairs:
     core_nodes: np.ndarray | None = None  # (m, 2k + 1) (closest-point)
     segment_valid: np.ndarray | None = None  # (m, 2k): segment j joins core_nodes j and j + 1
     support_dofs: np.ndarray | None = None  # (m, 2 + 4 (2k + 1)) (closest-point)
+    # contact_pair_groups: the interface's pairs in one group (widest k), whose projection is
+    # computed once for all groups, and this group's rows in it
+    parent: ContactPairs | None = None
+    parent_rows: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -216,8 +221,13 @@ def contact_pair_groups(
         k[i] = contact_pairs(interface, nodes[i:i + 1], x, width, search=search,
                              reach=reach).core_nodes.shape[1] // 2
     bins = 2 ** np.ceil(np.log2(k)).astype(int)
-    return [contact_pairs(interface, nodes[bins == b], x, width, search=search, reach=reach)
-            for b in np.unique(bins)]
+    parent = contact_pairs(interface, nodes, x, width, search=search, reach=reach)
+    groups = []
+    for b in np.unique(bins):
+        rows = np.flatnonzero(bins == b)
+        g = contact_pairs(interface, nodes[rows], x, width, search=search, reach=reach)
+        groups.append(dataclasses.replace(g, parent=parent, parent_rows=rows))
+    return groups
 
 
 @dataclass(frozen=True)
@@ -268,7 +278,11 @@ def pair_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
         cached = getattr(pairs, "_last", None)
         if cached is not None and np.array_equal(cached[0], v):
             return cached[1]
-        k = _closest_point_kinematics(pairs, u_full)
+        if pairs.parent is None:
+            k = _scatter(pairs, _compact_kinematics(pairs, u_full), pairs.core_nodes.shape[1])
+        else:  # one projection for all the interface's groups
+            k = _scatter(pairs, _cached_compact(pairs.parent, u_full),
+                         pairs.parent.core_nodes.shape[1], pairs.parent_rows)
         object.__setattr__(pairs, "_last", (v, k))
         return k
     v = u_full[pairs.dofs]  # (m, 6)
@@ -326,7 +340,53 @@ def _segment_geometry(pairs: ContactPairs, u_full: np.ndarray):
     return xa, length, U, W, xs, v_face[:, 1:2]
 
 
-def _closest_point_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
+@dataclass(frozen=True)
+class _Compact:
+    """Closest-point kinematics on the chosen segment's 10 DOFs (u_f, w_f, U, W)."""
+
+    gap: np.ndarray  # (m,)
+    grad: np.ndarray  # (m, 10)
+    hess: np.ndarray  # (m, 10, 10)
+    cols: np.ndarray  # (m, 10) columns in the block of the pairs they were computed on
+    sliding: np.ndarray
+    xi: np.ndarray
+    segment: np.ndarray
+    outside: np.ndarray
+
+
+def _cached_compact(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
+    v = u_full[pairs.support_dofs]
+    cached = getattr(pairs, "_last_compact", None)
+    if cached is not None and np.array_equal(cached[0], v):
+        return cached[1]
+    c = _compact_kinematics(pairs, u_full)
+    object.__setattr__(pairs, "_last_compact", (v, c))
+    return c
+
+
+def _scatter(
+    pairs: ContactPairs, c: _Compact, width: int, rows: np.ndarray | None = None
+) -> PairKinematics:
+    """Place compact kinematics (computed with ``width`` core nodes per pair) in the block."""
+    if rows is None:
+        rows = np.arange(pairs.size)
+    m = rows.size
+    shift = 4 * ((width - pairs.core_nodes.shape[1]) // 2)  # parent slot j ↔ own slot j − k_Δ
+    cols = c.cols[rows]
+    cols = np.where(cols >= 2, cols - shift, cols)
+    n = pairs.support_dofs.shape[1]
+    g_full = np.zeros((m, n))
+    h_full = np.zeros((m, n, n))
+    r = np.arange(m)
+    g_full[r[:, None], cols] = c.grad[rows]
+    h_full[r[:, None, None], cols[:, :, None], cols[:, None, :]] = c.hess[rows]
+    # segment index in this group's own layout
+    seg = c.segment[rows] - shift // 4
+    return PairKinematics(c.gap[rows], g_full, h_full, c.sliding[rows], c.xi[rows], seg,
+                          c.outside[rows])
+
+
+def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     m = pairs.size
     xa, l, U, W, xs, ws = _segment_geometry(pairs, u_full)
     x_node = pairs.x[pairs.nodes][:, None]
@@ -388,17 +448,12 @@ def _closest_point_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKi
     grad = G[:, 1:]  # + g̃_ξ ξ_q, zero at the projection (g̃_ξ = s_n r·n_ξ ∝ φ)
     hess = (H[:, 1:, 1:] + H[:, 1:, :1] * ξq[:, None, :] + ξq[:, :, None] * H[:, :1, 1:]
             + H[:, :1, :1] * ξq[:, :, None] * ξq[:, None, :])
-    # scatter the segment's 10 DOFs into the pair's block
+    # the block columns of the segment's 10 DOFs
     base = 2 + 4 * seg[:, None]
     cols = np.concatenate([np.zeros((m, 1), int), np.ones((m, 1), int),
                            base + np.array([0, 1, 4, 5]), base + np.array([2, 3, 6, 7])], axis=1)
-    n = pairs.support_dofs.shape[1]
-    g_full = np.zeros((m, n))
-    h_full = np.zeros((m, n, n))
-    g_full[rows[:, None], cols] = grad
-    h_full[rows[:, None, None], cols[:, :, None], cols[:, None, :]] = hess
     sliding = xa[rows, seg] + ls * ξs - x_node[:, 0]
-    return PairKinematics(gap, g_full, h_full, sliding, ξs, seg, outside)
+    return _Compact(gap, grad, hess, cols, sliding, ξs, seg, outside)
 
 
 SHIFT = 25.0  # c: the softplus is centred at g = −c s, so dp/dg jumps by only ε e⁻²⁵ at g = 0

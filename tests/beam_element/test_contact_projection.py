@@ -22,6 +22,7 @@ from beam_element import run
 from beam_element.contact import (
     NORMAL_SIGN,
     contact_energy,
+    contact_pair_groups,
     contact_pairs,
     hermite_basis,
     pair_kinematics,
@@ -39,9 +40,8 @@ NODES = np.arange(1, 7)  # untied nodes: all but the ends
 FIG5 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
 
 
-def _core_fields(theta, amp):
+def _core_fields(theta, amp, L=X[-1]):
     """Core boundary (u, u', w, w'): a rigid rotation θ about x = 0 plus a smooth wave."""
-    L = X[-1]
 
     def fields(x):
         k = np.pi / L
@@ -74,19 +74,19 @@ def _curve(x_nodes, nodal, s):
     return np.array([s + val[0], val[1]]), np.array([1.0 + der[0], der[1]])
 
 
-def _state(interface, slide, gap, theta=0.3, amp=0.4):
+def _state(interface, slide, gap, theta=0.3, amp=0.4, x=X, nodes=NODES):
     """Full DOF vector: core boundary from _core_fields, face node i at X(x_i + d_i) + g_i n."""
-    u = np.zeros(NODE_DOFS * X.size)
+    u = np.zeros(NODE_DOFS * x.size)
     names = CONTACT_DOFS[interface]
-    nodal = np.stack(_core_fields(theta, amp)(X), axis=-1)
+    nodal = np.stack(_core_fields(theta, amp, x[-1])(x), axis=-1)
     for role, j in (("u_core", 0), ("u_core,x", 1), ("w_core", 2), ("w_core,x", 3)):
-        u[global_dof(np.arange(X.size), names[role])] = nodal[:, j]
+        u[global_dof(np.arange(x.size), names[role])] = nodal[:, j]
     s_n = NORMAL_SIGN[interface]
-    for i, d, g in zip(NODES, slide, gap, strict=True):
-        point, t = _curve(X, nodal, X[i] + d)
+    for i, d, g in zip(nodes, slide, gap, strict=True):
+        point, t = _curve(x, nodal, x[i] + d)
         n = s_n * np.array([-t[1], t[0]]) / np.hypot(*t)
         face = point + g * n
-        u[global_dof(i, names["u_face"])] = face[0] - X[i]
+        u[global_dof(i, names["u_face"])] = face[0] - x[i]
         u[global_dof(i, names["w_face"])] = face[1]
     return u
 
@@ -285,3 +285,36 @@ def test_consistent_tangent_with_sliding_inside_the_smoothing_band():
             fd = (_global(pairs, m, penalty_response(pairs, u + du, EPS, S)[0][m])
                   - _global(pairs, m, penalty_response(pairs, u - du, EPS, S)[0][m])) / (2 * h)
             assert np.allclose(KK[:, j], fd, rtol=1e-5, atol=1e-6 * np.abs(KK).max())
+
+
+def test_groups_by_search_width_give_the_ungrouped_force_and_tangent():
+    # graded nodes (0.2 - 3 mm): with a 1 mm reach the search half-width varies from 1 to 5
+    # segments, so contact_pair_groups makes groups of two widths; reference: one rectangular group
+    x = np.concatenate([[0.0], np.cumsum([3, 2, 1, 0.5, 0.3, 0.2, 0.2, 0.3, 0.5, 1, 2, 3.0])])
+    nodes = np.arange(1, x.size - 1)
+    rng = np.random.default_rng(5)
+    slide = rng.uniform(-0.15, 0.15, nodes.size)
+    gap = -rng.uniform(1e-4, 1e-2, nodes.size)
+    u = _state("bottom", slide, gap, x=x, nodes=nodes)
+    groups = contact_pair_groups("bottom", nodes, x, 60.0, search="closest-point", reach=1.0)
+    single = contact_pairs("bottom", nodes, x, 60.0, search="closest-point", reach=1.0)
+    assert len(groups) >= 2
+    assert sorted(np.concatenate([g.nodes for g in groups])) == list(nodes)
+    assert max(g.block_dofs.shape[1] for g in groups) == single.block_dofs.shape[1]
+    n = u.size
+
+    def assemble(pair_list):
+        F, K, gaps = np.zeros(n), np.zeros((n, n)), {}
+        for p in pair_list:
+            f, k_blocks, _, kin = penalty_response(p, u, EPS, S)
+            d = p.block_dofs
+            np.add.at(F, d, f)
+            np.add.at(K, (d[:, :, None], d[:, None, :]), k_blocks)
+            gaps.update(zip(p.nodes.tolist(), kin.gap, strict=True))
+        return F, K, gaps
+
+    F1, K1, g1 = assemble(groups)
+    F2, K2, g2 = assemble([single])
+    assert g1 == pytest.approx(g2, abs=1e-15) and np.allclose(list(g2.values()), gap, atol=1e-12)
+    assert np.allclose(F1, F2, rtol=0, atol=1e-12 * np.abs(F2).max())
+    assert np.allclose(K1, K2, rtol=0, atol=1e-12 * np.abs(K2).max())
