@@ -3,15 +3,17 @@
 Pairing. Nodes strictly inside a debond are untied; at each of them the face's inner surface
 point (master) meets the core's boundary curve (slave). Two searches (``contact_pairs(search=)``):
 
-* ``"closest-point"`` (default of :func:`beam_element.model.build_model`): node-to-segment. The
-  master point is projected on the deformed core boundary curve, the gap is measured along the
-  slave's deformed normal at the projection, and the linearisation includes the motion of the
+* ``"closest-point"`` (option ``contact_search`` of :func:`beam_element.model.build_model`,
+  whose default is still same-x, see docs/beam_element.md): node-to-segment. The master point
+  is projected on the deformed core boundary curve, the gap is measured along the slave's
+  deformed normal at the projection, and the linearisation includes the motion of the
   projection point (below).
-* ``"same-x"``: node-to-node, the core boundary point of the *same material coordinate x*. It
-  assumes small relative sliding; the sliding s = t·Δ is returned so a user can check it.
+* ``"same-x"`` (default): node-to-node, the core boundary point of the *same material
+  coordinate x*. It assumes small relative sliding; the sliding s = t·Δ is returned so a user
+  can check it.
 
-Closest point (node-to-segment; Wriggers, Computational Contact Mechanics, §4.3 and §8.2 for the
-2D node-to-segment element with a curved segment; here written for the implicit function ξ(q)).
+Closest point (node-to-segment; cf. Wriggers, Computational Contact Mechanics, ch. 4 and 8, the
+2D node-to-segment element on a curved segment; written here via the implicit function ξ(q)).
 On a core segment [x_a, x_b] of length l, ξ ∈ [0, 1], the deformed boundary is
 
     X(ξ) = (x_a + l ξ + Σ_k N_k(ξ) U_k,  z + Σ_k N_k(ξ) W_k),
@@ -50,7 +52,9 @@ the classical NTS terms of the moving contact point (with the curvature through 
 g̃_ξξ); g̃_qq holds the rotation of the normal. The gap is C¹ in q across segment switches
 (n and the nodal values are continuous there); its Hessian jumps with the curvature. Force and
 tangent act on the pair's block (face node + core nodes of the searched segments), so the sparse
-pattern is fixed. The sliding reported is the material distance x(ξ) − x_i of the projection.
+pattern is fixed; :func:`contact_pair_groups` groups an interface's pairs by search width (blocks
+no wider than needed on graded meshes) and the projection is computed once for all its groups.
+The sliding reported is the material distance x(ξ) − x_i of the projection.
 
 Gap (eq. 42), same-x. The slave boundary's deformed tangent is t ∝ (1 + u_c,x, w_c,x), its
 outward normal n = s_n (−w_c,x, 1 + u_c,x)/ℓ with ℓ = |(1 + u_c,x, w_c,x)| and s_n = +1 on the

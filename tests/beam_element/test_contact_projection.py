@@ -9,7 +9,8 @@ References, test by test:
   the exact (material) sliding s − x_i;
 - derivatives: central finite differences of the code's own gap, force and energy;
 - zero sliding: the same-x gap (eq. 42, its derivatives are checked in test_beam_tangent.py);
-- a real scene (fig. 5): the issue's bound, penetration ≤ 1e-3 × face thickness.
+- a real scene (fig. 5): the issue's bound, penetration ≤ 1e-3 × face thickness;
+- width groups (``contact_pair_groups``): the same pairs in one rectangular group.
 """
 
 import dataclasses
