@@ -216,8 +216,19 @@ class Scene:
                             key=lambda d: d.start))
 
     def is_bonded(self, interface: str, x: float, tol: float = 1e-9) -> bool:
-        """Whether ``x`` is bonded on ``interface`` (debond tips count as bonded)."""
-        return not any(d.start + tol < x < d.end - tol for d in self.debonds_on(interface))
+        """Whether ``x`` is bonded on ``interface``.
+
+        Debond tips (ends inside the beam) count as bonded. The end of a debond that reaches a
+        beam end is an open mouth, not a tip: the face and the core are not attached there.
+        A zero-length debond is bonded everywhere.
+        """
+        at_beam_end = x <= tol or x >= self.length - tol
+        for d in self.debonds_on(interface):
+            if d.start + tol < x < d.end - tol:
+                return False
+            if at_beam_end and d.end - d.start > tol and d.start - tol <= x <= d.end + tol:
+                return False
+        return True
 
     def probe(self, name: str) -> Probe:
         """The probe called ``name``."""

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from beam_element.dofs import global_dof
 from beam_element.solve import run
 from sandwich.scene import load_scene
 
@@ -36,3 +37,23 @@ def test_face_membrane_option_changes_the_nonlinear_answer_only():
                - avg[1].load_factor / avg[1].probes["w_top_mid"]) < 1e-2 * abs(
         paper[1].load_factor / paper[1].probes["w_top_mid"])
     assert avg[-1].load_factor < paper[-1].load_factor * 0.95  # locking removed: softer
+
+
+def test_open_mouth_at_a_clamp_leaves_the_core_corner_free():
+    """Cantilever c2 (faces clamped at x = 0, top debond 0-40): the core's top corner at the
+    clamp is not tied to the clamped face, so it moves while the face does not; with the mouth
+    tied (debond from 1e-6 mm, so x = 0 is bonded) it cannot. Reference: the scene's geometry."""
+    base = load_scene(ROOT / "scenes" / "paper-fig7-cantilever-c2.toml")
+    an = dataclasses.replace(base.analysis, kind="linear", until_probe=None, until_value=None,
+                             until_load_factor=10.0)
+    corner = {}
+    for label, start in (("open", 0.0), ("tied", 1e-6)):
+        db = tuple(dataclasses.replace(d, start=start) for d in base.debonds)
+        sc = dataclasses.replace(base, analysis=an, debonds=db,
+                                 beam_model=dataclasses.replace(base.beam_model, elements=60))
+        r = run(sc)
+        u = r.model.expand(r.states[-1].u)
+        corner[label] = (abs(u[global_dof(0, "u_ct")]), abs(u[global_dof(0, "u_tb")]))
+    assert corner["open"][1] < 1e-12 and corner["tied"][1] < 1e-12  # the face is clamped
+    assert corner["tied"][0] < 1e-12
+    assert corner["open"][0] > 1e-4  # the untied core corner moves

@@ -4,6 +4,7 @@ The expected key and a fragment of the reason are written in each malformed file
 from the scene contract (issue 2) — not copied from the validator's output.
 """
 
+import dataclasses
 import glob
 import re
 from pathlib import Path
@@ -11,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from sandwich.cli import main
-from sandwich.scene import SceneError, load_scene
+from sandwich.scene import Debond, SceneError, load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 SHIPPED = sorted(glob.glob(str(ROOT / "scenes" / "*.toml")))
@@ -73,3 +74,14 @@ def test_fig9_periodic_debonds_are_symmetric_and_bonded_at_midspan():
         assert [v for s in spans for v in s] == pytest.approx([v for s in mirrored for v in s])
         assert scene.is_bonded(itf, 150.0)
         assert all(b - a <= 16 + 1e-9 for a, b in spans)
+
+
+def test_debond_reaching_a_beam_end_is_open_there_and_bonded_at_its_tip():
+    """A debond that reaches a beam end has one tip (bonded) and an open mouth (not bonded)."""
+    scene = load_scene(ROOT / "scenes" / "paper-fig7-cantilever-c2.toml")  # top debond 0-40
+    assert not scene.is_bonded("top", 0.0)  # mouth at the clamped end
+    assert not scene.is_bonded("top", 20.0)
+    assert scene.is_bonded("top", 40.0)  # the tip
+    assert scene.is_bonded("bottom", 0.0)
+    zero = dataclasses.replace(scene, debonds=(Debond("top", 0.0, 0.0),))
+    assert zero.is_bonded("top", 0.0)  # a zero-length debond is bonded
