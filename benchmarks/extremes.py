@@ -38,6 +38,7 @@ import dataclasses
 import math
 import multiprocessing
 import os
+import re
 import signal
 import sys
 import time
@@ -345,8 +346,9 @@ def agreement(scene: Scene, beam: Solution | None, ref: Solution | None) -> dict
     if out["common"] is not None and out["common"] < 1 - 1e-3:
         short = [m for m, s in (("beam", beam), ("2D", ref))
                  if (_fraction(scene, s) or 0.0) < 1 - 1e-3]
-        notes.append(f"compared up to {100 * out['common']:.0f} % of the target "
-                     f"({' and '.join(short) or 'a path'} stopped early)")
+        why = (f"{' and '.join(short)} stopped early" if short else
+               "a path turns back in the compared quantity")
+        notes.append(f"compared up to {100 * out['common']:.0f} % of the target ({why})")
     out["agree_note"] = "; ".join(notes)
     return out
 
@@ -404,10 +406,13 @@ def _short(note: str, n: int = 170) -> str:
     """A note for the table: its start and, for a failed step, the solver's last reason."""
     head, sep, reason = note.partition("; last reason: ")
     head = head if len(head) <= n else head[:n] + " …"
-    return head + (f"; last reason: {reason.split('.')[0][:n]}" if sep else "")
+    first = re.split(r"[.](?:\s|$)", reason)[0][:n]  # up to the end of its first sentence
+    return head + (f"; last reason: {first}" if sep else "")
 
 
 def _status_cell(r: dict[str, object], model: str) -> str:
+    if r.get(f"{model}_status") in (None, ""):
+        return "—"
     st = _label(r, model)
     reached = r.get(f"{model}_reached")
     if st == "converged" or reached in (None, ""):
@@ -451,8 +456,12 @@ def write(rows: list[dict[str, object]], out: Path, header: list[str] | None = N
                      f"{_pct(r.get('check_end_error'))} |")
         md.append(line)
     md += ["", "Notes (why a model stopped or was not run, what was compared):", ""]
+    caps = [r.get("cap_s") for r in rows if r.get("cap_s") not in (None, "")]
+    usual = max(set(caps), key=caps.count) if caps else None
     for r in rows:
         parts = []
+        if r.get("cap_s") not in (None, "", usual):
+            parts.append(f"run with a wall-time cap of {float(r['cap_s']):g} s")
         for model, label in (("beam", "beam"), ("2d", "2D"), (CHECK, "2D check")):
             st = r.get(f"{model}_status")
             if st is not None and st != "converged":
@@ -602,6 +611,9 @@ def main(argv: list[str] | None = None) -> int:
             del use[CHECK]
         print(f"{sweep} = {value:g}", flush=True)
         r = row(sweep, value, scene, run_models(scene, use, cfg["timeout"], args.parallel))
+        r.update(elements=cfg["elements"], level=cfg["level"], cap_s=cfg["timeout"],
+                 max_cells=cfg["max_cells"], check_level=args.check_level if CHECK in use
+                 else None, commit=_commit(), finished=time.strftime("%Y-%m-%d %H:%M:%S"))
         print("   " + ", ".join(f"{m}: {r[f'{m}_status']} {r[f'{m}_seconds']} s"
                                 for m in use) + f"; L2 {_pct(r['load_l2'])}", flush=True)
         rows = [x for x in rows if not (x["sweep"] == sweep and math.isclose(float(x["value"]),
@@ -610,6 +622,17 @@ def main(argv: list[str] | None = None) -> int:
         rows.sort(key=lambda x: (list(SWEEPS).index(x["sweep"]), _index(x)))
         write(rows, args.out, header)  # partial map survives a crash or an interrupt
     return 0 if rows else 1
+
+
+def _commit() -> str:
+    """The repository's HEAD when a case finished (models are imported afresh per case)."""
+    import subprocess
+
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return ""
 
 
 def _index(r: dict[str, object]) -> int:
