@@ -22,6 +22,18 @@ FIG4_CRUSH = pytest.mark.xfail(strict=True, reason=(
     "the Green-strain core (eq. 27) crushes under the patch: material limit point "
     "lambda=1930.67 at w=-12.99 mm, next steps invert core cells; -15 mm is out of reach "
     "(docs/reference2d.md)"))
+# measured (docs/reference2d.md, "Heavy full paths"): the same St. Venant-Kirchhoff core limit as
+# fig4, at a corner where a face end is held and the core bears on it
+CORNER_CRUSH = {
+    "paper-fig6-top-debond-20-load-bottom": pytest.mark.xfail(strict=True, reason=(
+        "core corner above the pin (x=0, z=-12.5) crushes: min principal stretch 0.593 "
+        "(SVK uniaxial limit 0.577), load limit point lambda=1983.07 at w_bottom_mid=-9.58 mm; "
+        "-15 mm is out of reach")),
+    "paper-fig7-cantilever-c2": pytest.mark.xfail(strict=True, reason=(
+        "core corner on the clamped bottom face (x=0, z=-12.5) crushes past the SVK limit "
+        "(stretch 0.33 -> 0 while lambda falls 659 -> 631) and inverts at w_top_tip=-32.1 mm; "
+        "-40 mm is out of reach")),
+}
 UNTIL = re.compile(r"(until\s*=\s*\{[^}]*value\s*=\s*)([-+0-9.eE]+)")
 FRACTION = 0.2
 
@@ -60,8 +72,8 @@ def test_shipped_scene_coarse_short_path(name, tmp_path):
 
 @pytest.mark.heavy
 @pytest.mark.parametrize("name", [
-    pytest.param(n, marks=FIG4_CRUSH)
-    if n == "paper-fig4-bonded-3pb" else n for n in NAMES])
+    pytest.param(n, marks=FIG4_CRUSH) if n == "paper-fig4-bonded-3pb"
+    else pytest.param(n, marks=CORNER_CRUSH[n]) if n in CORNER_CRUSH else n for n in NAMES])
 def test_shipped_scene_coarse_full_path(name):
     scene = load_scene(SCENES / f"{name}.toml")
     sol = solve(scene, level="coarse")
