@@ -295,6 +295,16 @@ def _history_cuts(sol: Solution) -> int:
 
 # -- one row of the map ---------------------------------------------------------------------------
 
+def _backsteps(scene: Scene, sol: Solution | None) -> int:
+    """Steps at which |until probe| goes back (a snap-back of the probe, or a path retracing
+    itself) plus steps with a reversed load (λ < 0)."""
+    a = scene.analysis
+    if sol is None or len(sol.history) < 2 or a.until_probe not in sol.history[0].probes:
+        return 0
+    w = np.abs([r.probes[a.until_probe] for r in sol.history])
+    return int(np.sum(np.diff(w) < 0) + sum(r.load_factor < 0 for r in sol.history))
+
+
 def _fraction(scene: Scene, sol: Solution | None) -> float | None:
     """|until probe| reached (largest along the path) / |target|; λ / target if load-driven."""
     a = scene.analysis
@@ -366,6 +376,7 @@ def row(sweep: str, value: float, scene: Scene, runs: dict[str, Outcome]) -> dic
         out[f"{model}_steps"] = max(len(s.history) - 1, 0) if s else 0  # state 0 not a step
         out[f"{model}_iterations"] = sum(h.iterations for h in s.history) if s else 0
         out[f"{model}_cuts"] = r.cuts
+        out[f"{model}_backsteps"] = _backsteps(scene, s)
         out[f"{model}_seconds"] = round(r.seconds, 2)  # the child process: imports, mesh, solve
         out[f"{model}_solve_seconds"] = (round(s.wall_seconds, 2) if s and r.status in
                                          ("converged", "stopped") else None)
@@ -415,9 +426,11 @@ def _status_cell(r: dict[str, object], model: str) -> str:
         return "—"
     st = _label(r, model)
     reached = r.get(f"{model}_reached")
+    back = r.get(f"{model}_backsteps")
+    turn = f" ↺{back}" if back not in (None, "", 0) else ""
     if st == "converged" or reached in (None, ""):
-        return MARK.get(st, st)
-    return f"{MARK.get(st, st)} {100 * float(reached):.0f} %"
+        return MARK.get(st, st) + turn
+    return f"{MARK.get(st, st)} {100 * float(reached):.0f} %{turn}"
 
 
 def write(rows: list[dict[str, object]], out: Path, header: list[str] | None = None) -> None:
@@ -432,7 +445,8 @@ def write(rows: list[dict[str, object]], out: Path, header: list[str] | None = N
           f"Base scene: {BASE}. Status: ✓ reached the target; ✗ N % stopped before it (N = "
           "|until probe| reached / target); ✓✗ N % passed the target but could not hit it "
           "within the solver's target_tol (a converged path past the target); ✗! the solve "
-          "raised; ⏱ wall-time cap; – not run "
+          "raised; ⏱ wall-time cap; – not run; ↺N: N steps went back in |until probe| or had "
+          "λ < 0 (a snap-back or a path retracing itself) "
           "(reason in the notes / CSV). Agreement: beam load curve against the 2D one as a "
           "function of |until probe|, over the common range (`common` = its end / target), "
           "over the first 10 % of the target (`lin`), and the load error at the end of the "
@@ -491,14 +505,21 @@ def _plot(rows: list[dict[str, object]], path: Path) -> None:
                        c=[COLOURS.get(_label(r, model), "black") for r in rs])
             for j, r in enumerate(rs):
                 fr = r.get(f"{model}_reached")
-                if _label(r, model) != "converged" and fr not in (None, ""):
-                    ax.annotate(f"{100 * float(fr):.0f}%", (j, i), ha="center", va="center",
-                                fontsize=6)
+                text = (f"{100 * float(fr):.0f}%" if _label(r, model) != "converged"
+                        and fr not in (None, "") else "")
+                if r.get(f"{model}_backsteps") not in (None, "", 0):
+                    text += "↺"
+                if text:
+                    ax.annotate(text, (j, i), ha="center", va="center", fontsize=6)
         for j, r in enumerate(rs):
             if r.get("load_l2") is not None:
                 e = float(r["load_l2"])
                 colour = "green" if e <= 0.03 else "darkorange" if e <= 0.10 else "red"
-                ax.annotate(f"{100 * e:.1f}%", (j, 0.5), ha="center", fontsize=7, color=colour)
+                c = r.get("common")
+                short = c not in (None, "") and float(c) < 0.99
+                upto = f"\n(to {100 * float(c):.0f}%)" if short else ""
+                ax.annotate(f"{100 * e:.1f}%{upto}", (j, 0.5), ha="center", va="center",
+                            fontsize=7, color=colour)
         ax.set_xticks(range(len(rs)), [f"{r['value']:g}" for r in rs], fontsize=7)
         ax.set_yticks([0, 1], ["beam", "2D"])
         ax.set_ylim(-0.6, 1.6)
@@ -510,7 +531,8 @@ def _plot(rows: list[dict[str, object]], path: Path) -> None:
                for k, c in COLOURS.items() if k != "missing"]
     fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=7, frameon=False)
     fig.suptitle("squares: model status (% = path reached when short); numbers: load-curve L2 "
-                 "beam vs 2D over the common range (green ≤ 3 %, orange ≤ 10 %, red > 10 %)",
+                 "beam vs 2D over the common range, (to N%) when it ends before the target; "
+                 "↺ path went back (green ≤ 3 %, orange ≤ 10 %, red > 10 %)",
                  fontsize=8)
     fig.tight_layout(rect=(0, 0.08, 1, 0.95))
     fig.savefig(path, dpi=120)

@@ -31,7 +31,8 @@ load level). Three parts:
    100: λ(−15 mm) = 1126 at 60 elements, 822 at 240).
 
 3. **Nonlinear, at the map's settings** (240 graded elements): the beam reaches the target at
-   the edges (the cheap ones in the default suite, debond 0.9 span and load ×2 ``heavy``); and
+   the edges (the cheap ones in the default suite, debond 0.9 span and load ×2 ``heavy``; load ×2
+   is a strict xfail: its path retraces at the load maximum, see docs/extremes.md); and
    (``heavy``) beam and 2D reference at level coarse, both run here, on the edge cases the map
    found in agreement: the load curves must agree within the class the map put them in (3 % or
    10 % relative L2 over the common range). Reference: the 2D model.
@@ -150,6 +151,9 @@ def sweep_scene(sweep: str, value: float) -> Scene:
 
 
 def _assert_reaches_target(scene: Scene, sol) -> None:
+    """Converged to the target along a path that goes forward: every step moves |until probe|
+    on (no retrace; neither model shows a snap-back of w_top_mid on these scenes in the map) and
+    the load never reverses (λ ≥ 0), every state finite."""
     a = scene.analysis
     assert sol.converged, sol.message
     last = sol.history[-1]
@@ -158,6 +162,10 @@ def _assert_reaches_target(scene: Scene, sol) -> None:
     for rec in sol.history:
         assert math.isfinite(rec.load_factor)
         assert all(math.isfinite(v) for v in rec.probes.values())
+    w = np.abs([rec.probes[a.until_probe] for rec in sol.history])
+    back = np.flatnonzero(np.diff(w) <= 0)
+    assert back.size == 0, f"|{a.until_probe}| goes back at steps {back[:5] + 1} of {w.size}"
+    assert min(rec.load_factor for rec in sol.history) >= 0.0
 
 
 FAST_EDGES = [("stiffness", 1e-5), ("thickness", 10), ("thickness", 100), ("slenderness", 5),
@@ -201,7 +209,10 @@ def test_beam_agrees_with_2d_at_the_edges_of_the_map(sweep, value, tol, common):
 MAP_CONVERGED_EDGES = [  # cheap at 240 elements (~1-2 s each unloaded): default suite
     ("stiffness", 1e-5), ("thickness", 100), ("slenderness", 20),
     pytest.param("debond", 0.9, marks=pytest.mark.heavy),  # 255 steps
-    pytest.param("load", 2.0, marks=pytest.mark.heavy),
+    pytest.param("load", 2.0, marks=[pytest.mark.heavy, pytest.mark.xfail(strict=True, reason=(
+        "at 240 elements the arc-length path turns back at the load maximum (λ ≈ 2292, "
+        "w ≈ −28.7 mm), retraces to λ ≈ 1510, later runs through λ < 0 (w_top up to +59 mm) "
+        "and only then reaches −30 mm (327 steps, 110 cuts); docs/extremes.md"))]),
 ]
 
 
