@@ -117,7 +117,7 @@ class ContactState:
     gap: np.ndarray  # (ns,) signed gaps (mm), negative = penetration
     slip: np.ndarray  # (ns,) tangential offset of the slave from its anchor (mm)
     pressure: np.ndarray  # (ns,) p = k ⟨−g⟩ (MPa)
-    active: np.ndarray  # (na,) indices of the slaves with g < 0
+    active: np.ndarray  # (na,) indices of the slaves with g <= 0
     rows: np.ndarray  # (na, 4) their nodes (s, 0, 1, 2)
     forces: np.ndarray  # (na, 8) ∂Π/∂X
     tangents: np.ndarray | None  # (na, 8, 8) ∂²Π/∂X² (None unless asked for)
@@ -145,7 +145,9 @@ def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
     L = np.sqrt(np.einsum("ni,ni->n", chord, chord))
     slips = np.einsum("ni,ni->n", d, chord) / L
     gaps = np.einsum("ni,ni->n", (chord @ J.T) / L[:, None], d)  # as in gaps_with_derivatives
-    active = np.flatnonzero(gaps < 0.0)
+    # g = 0 counts as active (force 0, tangent k b w ∇g ∇gᵀ, a valid choice at the kink of
+    # ⟨−g⟩²): lips that touch in the reference state start supported instead of free
+    active = np.flatnonzero(gaps <= 0.0)
     g, dg, d2g = gaps_with_derivatives(d[active], chord[active])
     kw = pair.penalty * pair.width * pair.weight[active]
     forces = (kw * g)[:, None] * dg

@@ -75,6 +75,25 @@ def input_node_blocks(V) -> dict[int, int]:
     return dict(zip(np.asarray(inputs)[geo].tolist(), dofs.tolist(), strict=True))
 
 
+def block_input_coordinates(V) -> np.ndarray:
+    """(local blocks, 2): the coordinates of every DOF block copied from the mesh geometry.
+
+    ``V.tabulate_dof_coordinates()`` evaluates the coordinate map in a cell, so two input nodes
+    at the same point but in different cells (the face and core nodes of a debond lip) can come
+    out a few ulps apart. The geometry array holds the input points themselves: coincident lip
+    nodes get bitwise equal coordinates, and their reference gap is exactly zero.
+    """
+    msh = V.mesh
+    x_dofmap = msh.geometry.dofmap
+    n_cells = msh.topology.index_map(2).size_local + msh.topology.index_map(2).num_ghosts
+    geo = np.array([x_dofmap.links(c) for c in range(n_cells)]).ravel()
+    dofs = np.array([V.dofmap.cell_dofs(c) for c in range(n_cells)]).ravel()
+    n_blocks = V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts
+    out = np.zeros((n_blocks, 2))
+    out[dofs] = msh.geometry.x[geo, :2]
+    return out
+
+
 def allreduce_array(comm, a: np.ndarray, op) -> np.ndarray:
     """Element-wise MPI reduction of a numpy array (a new array, same shape and dtype)."""
     a = np.ascontiguousarray(a)

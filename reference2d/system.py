@@ -23,7 +23,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from reference2d import contact as ct
-from reference2d.mesh import allreduce_array, input_node_blocks
+from reference2d.mesh import allreduce_array, block_input_coordinates, input_node_blocks
 
 JIT = {"cffi_extra_compile_args": ["-O2"]}
 
@@ -312,7 +312,9 @@ class Reference2DSystem:
         gblock = np.full(nc, -1, dtype=np.int64)
         gblock[owned] = im.local_range[0] + local[owned]
         xref = np.zeros((nc, 2))
-        xref[owned] = self.x_ref[local[owned]]
+        # exact input coordinates (not tabulate_dof_coordinates, which may put the two nodes of
+        # a closed lip a few ulps apart and so start every lip node open or shut at random)
+        xref[owned] = block_input_coordinates(self.V)[local[owned]] if nc else xref[owned]
         if self.comm.size > 1:
             gblock = allreduce_array(self.comm, gblock, MPI.MAX)
             xref = allreduce_array(self.comm, xref, MPI.SUM)
