@@ -10,6 +10,12 @@ Convergence (both tests, checked after every correction; at least one correction
   (displacement per unit λ). Newton converges quadratically, so a last correction of relative
   size √tol leaves an error of relative size ~tol: the two tests ask for the same accuracy.
 
+Round-off floor: a system may provide ``residual_roundoff(u)`` (N), the level below which its
+residual cannot be evaluated at ``u`` (e.g. ε ‖|K(u)| |u|‖). When the increment test passes but
+the residual test does not, a residual at or below that floor is accepted ("converged to the
+round-off floor"): the tolerance is fixed for the whole path while the round-off of a softening
+structure grows along it (the 2D cantilevers c3/c4 stalled that way, docs/reference2d.md).
+
 Divergence (reported as a failed :class:`NewtonResult`, never raised): a non-finite residual or
 iterate, a singular tangent, a constraint without solution, a residual grown by more than
 ``divergence_factor`` over the first one, or ``max_iterations`` corrections without convergence.
@@ -135,12 +141,18 @@ def newton_correct(
                         settings.force_floor, _TINY)
             if last_step is not None:
                 inc_scale = max(_norm(u - u0, lam - lam0, psi, dot), _norm(u, lam, psi, dot))
-                if r_norm <= settings.tol * scale and last_step <= tol_inc * inc_scale:
+                small_step = last_step <= tol_inc * inc_scale
+                how = ""
+                if small_step and r_norm <= settings.tol * scale:
+                    how = "converged"
+                elif small_step and r_norm <= _roundoff(system, u):
+                    how = "converged to the round-off floor"
+                if how:
                     try:
                         fac = system.factorize(system.tangent(u))
                     except RECOVERABLE_ERRORS as exc:
                         return fail(f"tangent at the converged state is singular: {exc}", it)
-                    return NewtonResult(True, u, lam, it, r_norm, "converged", fac)
+                    return NewtonResult(True, u, lam, it, r_norm, how, fac)
             if r_first is None:
                 r_first = max(r_norm, settings.tol * scale)
             elif r_norm > settings.divergence_factor * r_first:
@@ -166,6 +178,18 @@ def newton_correct(
         f"no convergence in {settings.max_iterations} iterations (residual {r_norm:.3e})",
         settings.max_iterations,
     )
+
+
+def _roundoff(system: DiscreteSystem, u: np.ndarray) -> float:
+    """The system's residual round-off level at ``u`` (0 if it does not say)."""
+    floor = getattr(system, "residual_roundoff", None)
+    if not callable(floor):
+        return 0.0
+    try:
+        value = float(floor(u))
+    except RECOVERABLE_ERRORS:
+        return 0.0
+    return value if math.isfinite(value) and value > 0.0 else 0.0
 
 
 def solve_equilibrium(
