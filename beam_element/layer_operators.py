@@ -92,8 +92,10 @@ class LayerOperators:
 
     @cached_property
     def u_columns(self) -> np.ndarray:
-        """Boolean mask of the layer's u DOFs, shape ``(n,)``: N rows vanish off them, M rows on
-        them."""
+        """Boolean mask of the layer's u DOFs, shape ``(n,)``.
+
+        N rows vanish off them, M rows on them.
+        """
         return np.array([DOF_TABLE[int(d) % NODE_DOFS].field == "u" for d in self.dofs])
 
     @cached_property

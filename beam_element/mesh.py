@@ -175,7 +175,8 @@ def build_mesh(
             return 1.0 / np.minimum(size_ratio * h_min, h_min + (growth - 1.0) * d)
 
         def count(h_min: float) -> float:
-            return float(np.sum(0.5 * (lambda v: v[1:] + v[:-1])(inverse_size(h_min)) * np.diff(grid)))
+            v = inverse_size(h_min)
+            return float(np.sum(0.5 * (v[1:] + v[:-1]) * np.diff(grid)))
 
         lo, hi = length / elements / size_ratio * 1e-3, length  # count(lo) > elements > count(hi)
         for _ in range(200):

@@ -106,6 +106,19 @@ class BeamModel:
         assert K is not None
         return K
 
+    def residual_roundoff(self, u: np.ndarray) -> float:
+        """Round-off level of the residual at ``u`` (N): ε ‖ |K(u)| |u| ‖.
+
+        The state is stored to an ulp of each unknown and the stiffest terms (the faces' axial
+        and the ties' through-thickness stiffness) turn that into residual that no Newton
+        iterate can remove. It exceeds ``tol ‖λ f_ref‖`` for very soft cores (E_core/E_face
+        = 1e-6) and very slender beams (L/h = 1000); the Newton corrector accepts a residual
+        at this level once the increment has converged (:mod:`sandwich.solver.newton`).
+        """
+        K = self.tangent(u)
+        absK = abs(K)
+        return float(np.finfo(float).eps * np.linalg.norm(absK @ np.abs(u)))
+
     def factorize(self, K: sp.spmatrix) -> object:
         """Sparse LU of the tangent (with inertia when the shared backend provides it)."""
         try:
@@ -300,8 +313,9 @@ def build_model(
     options = getattr(scene, "beam_model", None)
     if elements is None:
         elements = getattr(options, "elements", 120)
-    mesh = build_mesh(scene.length, elements, mesh_stations(scene), centres=refinement_centres(scene),
-                      grading=grading, growth=growth, size_ratio=size_ratio)
+    mesh = build_mesh(scene.length, elements, mesh_stations(scene),
+                      centres=refinement_centres(scene), grading=grading, growth=growth,
+                      size_ratio=size_ratio)
     if not (np.isfinite(scene.width) and scene.width > 0):
         raise ValueError(f"beam width must be positive, got {scene.width!r}")
     orders = dict(EXACT_ORDER)
@@ -312,9 +326,9 @@ def build_model(
                  "core": core_stiffness(scene.core.material),
                  "bottom": face_stiffness(scene.bottom.material)}
     thickness = {"top": ht, "core": hc, "bottom": hb}
-    layers = {n: build_layer_operators(n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n],
-                                       membrane_average=(n != "core" and face_membrane == "averaged"))
-              for n in LAYERS}
+    layers = {n: build_layer_operators(
+        n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n],
+        membrane_average=(n != "core" and face_membrane == "averaged")) for n in LAYERS}
     products = {n: geometric_products(op) for n, op in layers.items()}
 
     tol = 1e-9 * scene.length
