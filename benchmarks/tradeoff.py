@@ -29,6 +29,8 @@ import argparse
 import csv
 import dataclasses
 import math
+import os
+import platform
 import sys
 import time
 from collections.abc import Callable
@@ -207,9 +209,6 @@ def main(argv: list[str] | None = None) -> int:
             until[name] = float(value)
         except ValueError:
             ap.error(f"--until {item!r}: expected SCENE=VALUE with a number")
-    import os
-    import platform
-
     import beam_element
     import reference2d
 
