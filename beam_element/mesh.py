@@ -2,16 +2,17 @@
 
 Stations are x positions that must be nodes: the beam ends, debond ends, supports, load points and
 patch edges, probes. A subset of them, the *refinement centres* (supports, debond tips, point
-loads and patch edges), attracts small elements.
+loads and patch edges), attracts small elements, and so may whole intervals, the *refinement
+zones* (the debonded stretches, where a face buckles or wrinkles over its whole free length).
 
 Element sizes follow a size function h(x) (mm):
 
 * ``uniform``: h = const;
 * ``graded`` (default): h(x) = min(h_max, h_min + (r − 1) d(x)), d = distance to the nearest
-  refinement centre, h_max = q · h_min. Elements next to a centre have length ≈ h_min and grow
-  geometrically by about r per element (``growth``, default 1.2, bounded by 1.3) until they reach
-  h_max (``size_ratio`` q, default 12). h_min is set by bisection so that ∫ dx / h = the requested
-  element count.
+  refinement centre or zone (0 inside a zone), h_max = q · h_min. Elements next to a centre
+  (and all along a zone) have length ≈ h_min and grow geometrically by about r per element
+  (``growth``, default 1.2, bounded by 1.3) until they reach h_max (``size_ratio`` q, default
+  12). h_min is set by bisection so that ∫ dx / h = the requested element count.
 
 Each stretch between consecutive stations receives a whole number of elements (≥ 1) by largest
 remainders of ∫ dx/h over it, so the total is **exactly** the requested count (ValueError if that
@@ -85,6 +86,15 @@ def _clean(points: Iterable[float], length: float, tol: float, what: str) -> np.
     return np.sort(np.clip(pts, 0.0, length))
 
 
+def _clean_zones(zones: Iterable[tuple[float, float]], length: float, tol: float) -> np.ndarray:
+    z = np.array([tuple(map(float, ab)) for ab in zones], dtype=float).reshape(-1, 2)
+    if z.size:
+        _clean(z.ravel(), length, tol, "refinement zones")
+        if np.any(z[:, 1] <= z[:, 0]):
+            raise ValueError(f"refinement zones must have start < end, got {z.tolist()}")
+    return np.clip(z, 0.0, length)
+
+
 def _largest_remainders(share: np.ndarray, total: int) -> np.ndarray:
     """Integers n_k ≥ 1 summing to ``total`` and close to the positive reals ``share``."""
     k = share.size
@@ -111,6 +121,7 @@ def build_mesh(
     merge_tol: float | None = None,
     *,
     centres: Iterable[float] | None = None,
+    zones: Iterable[tuple[float, float]] = (),
     grading: str = "graded",
     growth: float = DEFAULT_GROWTH,
     size_ratio: float = DEFAULT_SIZE_RATIO,
@@ -129,6 +140,8 @@ def build_mesh(
         Stations closer than this are merged (default 1e-6 × length).
     centres
         Refinement centres for ``graded`` (default: the stations and the beam ends).
+    zones
+        Refinement zones (a, b), a < b, for ``graded``: h = h_min across each of them.
     grading
         ``"graded"`` or ``"uniform"`` (see the module docstring).
     growth
@@ -157,10 +170,14 @@ def build_mesh(
         c = _clean([0.0, length] if centres is None else [0.0, length, *centres], length, tol,
                    "refinement centres")
         c = np.unique(c)
+        z = _clean_zones(zones, length, tol)
 
         def density(x: np.ndarray) -> np.ndarray:
-            # 1/h relative to h_min: h/h_min = min(q, 1 + (r − 1) d / h_min) — h_min set below.
+            # distance d to the nearest centre or zone; h/h_min = min(q, 1 + (r − 1) d / h_min)
             d = np.min(np.abs(x[:, None] - c[None, :]), axis=1)
+            if z.size:
+                dz = np.maximum(z[None, :, 0] - x[:, None], x[:, None] - z[None, :, 1])
+                d = np.minimum(d, np.maximum(dz, 0.0).min(axis=1))
             return d
 
     # Fine sampling grid containing every station, for ∫ dx/h by the trapezoidal rule.

@@ -37,6 +37,7 @@ from beam_element.loads import patch_load, point_load, probe_row
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
 
+GRADINGS = ("graded", "tips", "uniform")
 CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
 PENALTY_FACTOR = 1e4  # default contact penalty ε = PENALTY_FACTOR · Q_z / h_c  (N/mm³)
 PENETRATION_BOUND = 1e-3  # allowed penetration / face thickness
@@ -257,6 +258,17 @@ def refinement_centres(scene: object) -> list[float]:
     return pts
 
 
+def refinement_zones(scene: object) -> list[tuple[float, float]]:
+    """Intervals the graded mesh fills with its smallest elements: the debonded stretches.
+
+    A debonded face is free to buckle or wrinkle over its whole length; with the paper's face
+    interpolation (u linear, w cubic) the buckled face locks in membrane unless its elements are
+    short all along the debond, not only at the tips (measured on fig. 5: docs/beam_element.md,
+    speed).
+    """
+    return [(d.start, d.end) for d in scene.debonds if d.end > d.start]
+
+
 def build_model(
     scene: object,
     *,
@@ -291,8 +303,10 @@ def build_model(
         penetration bound. 0 gives the plain (kinked) penalty.
     grading, growth, size_ratio
         Mesh along x (:func:`~beam_element.mesh.build_mesh`): ``"graded"`` (default) puts the
-        smallest elements at :func:`refinement_centres` and grows them by ``growth`` per element
-        up to ``size_ratio`` × the smallest; ``"uniform"`` keeps one size.
+        smallest elements at :func:`refinement_centres` and all along :func:`refinement_zones`
+        and grows them by ``growth`` per element up to ``size_ratio`` × the smallest;
+        ``"tips"`` grades towards the centres only (the default until 2026-11-22);
+        ``"uniform"`` keeps one size.
     face_membrane
         ``"paper"`` (default): the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"``
         (option, departs from the paper): the faces' ε_x is its element mean along x (assumed
@@ -313,8 +327,12 @@ def build_model(
     options = getattr(scene, "beam_model", None)
     if elements is None:
         elements = getattr(options, "elements", 120)
+    if grading not in GRADINGS:
+        raise ValueError(f"grading must be one of {GRADINGS}, got {grading!r}")
     mesh = build_mesh(scene.length, elements, mesh_stations(scene),
-                      centres=refinement_centres(scene), grading=grading, growth=growth,
+                      centres=refinement_centres(scene),
+                      zones=refinement_zones(scene) if grading == "graded" else (),
+                      grading="uniform" if grading == "uniform" else "graded", growth=growth,
                       size_ratio=size_ratio)
     if not (np.isfinite(scene.width) and scene.width > 0):
         raise ValueError(f"beam width must be positive, got {scene.width!r}")

@@ -158,7 +158,8 @@ class BeamModelOptions:
     """Resolution and numerics of the beam element model (table ``[beam_model]``)."""
 
     elements: int = 240  # fig5 to -15 mm: 240 graded elements within 4.5 % (paper element)
-    grading: str = "graded"  # "graded" (small at supports, loads, debond tips) | "uniform"
+    grading: str = "graded"  # "graded" (small at supports, load edges, debond tips and all along
+    # debonds) | "tips" (small at the points only) | "uniform"
     face_membrane: str = "paper"  # "paper" | "averaged" (element-mean face strain: no locking)
     gauss_x: int | None = None  # None: the rule that integrates the strain energy exactly
     gauss_z: int | None = None

@@ -407,7 +407,7 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     d = BeamModelOptions()
     return BeamModelOptions(
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
-        grading=r.choice(t, "grading", key, ("graded", "uniform"), default=d.grading)
+        grading=r.choice(t, "grading", key, ("graded", "tips", "uniform"), default=d.grading)
         or d.grading,
         face_membrane=r.choice(t, "face_membrane", key, ("paper", "averaged"),
                                default=d.face_membrane) or d.face_membrane,
