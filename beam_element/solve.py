@@ -27,6 +27,13 @@ MIN_INCREMENT_PER_SMOOTHING = 0.01  # default path increment floor / contact smo
 # plus the increment test), so 5 held the arc near 0.25 mm: 69 steps to −15 mm. With 8: 22 steps,
 # 168 iterations, same end state (λ 352.811). The floor (_min_increment) is unchanged.
 DESIRED_ITERATIONS = 8
+# A path whose converged states penetrate deeper than the model's bound (issue: 1e-3 × the face
+# thickness) is rerun with the penalty raised by PENALTY_GROWTH × (penetration / bound), at most
+# PENALTY_RESTARTS times. Penetration grows as the element length shrinks where a face presses
+# a point force on the core (a clamped mouth: fig. 7 c4 at 480 elements), so no fixed penalty
+# meets the bound at every resolution.
+PENALTY_RESTARTS = 2
+PENALTY_GROWTH = 2.0
 
 
 @dataclass(frozen=True)
@@ -172,27 +179,54 @@ def run(
     model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []
+    raised: list[float] = []
     if not nonlinear:
         states, message = _linear_states(model, scene)
         converged = True
     else:
-        from sandwich.solver.path import PathOptions, follow_path
-
-        options = PathOptions(
-            control=a.control, until_load_factor=a.until_load_factor, until_probe=a.until_probe,
-            until_value=a.until_value, max_steps=a.max_steps,
-            initial_increment=a.initial_increment, min_increment=_min_increment(model, a),
-            max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations,
-            desired_iterations=DESIRED_ITERATIONS,
-        )
-        result = follow_path(model, options, list(model.probe_rows), progress)
-        states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
-                  for s in result.states]
-        message, converged = result.message, result.reached_target
-        limit_points = list(result.limit_points)
+        while True:
+            states, message, converged, limit_points = _follow(model, scene, progress)
+            pen, bound = _max_penetration(model, states), model.penetration_bound()
+            if pen <= bound or len(raised) == PENALTY_RESTARTS:
+                break
+            raised.append(model.penalty)
+            penalty = model.penalty * PENALTY_GROWTH * pen / bound
+            model = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                                **{**options, "contact_penalty": penalty})
+        if raised:
+            message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
+                        f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
+                        f"penetrated deeper than {model.penetration_bound():.3g} mm)")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
+    solution.extra["contact_penalty_reruns"] = len(raised)
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _follow(
+    model: BeamModel, scene: object, progress: Callable[[object], None] | None
+) -> tuple[list[ConvergedState], str, bool, list[LimitPoint]]:
+    """Follow the nonlinear path of ``scene`` on ``model``: states, message, reached, limits."""
+    from sandwich.solver.path import PathOptions, follow_path
+
+    a = scene.analysis
+    options = PathOptions(
+        control=a.control, until_load_factor=a.until_load_factor, until_probe=a.until_probe,
+        until_value=a.until_value, max_steps=a.max_steps,
+        initial_increment=a.initial_increment, min_increment=_min_increment(model, a),
+        max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations,
+        desired_iterations=DESIRED_ITERATIONS,
+    )
+    result = follow_path(model, options, list(model.probe_rows), progress)
+    states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
+              for s in result.states]
+    return states, result.message, result.reached_target, list(result.limit_points)
+
+
+def _max_penetration(model: BeamModel, states: list[ConvergedState]) -> float:
+    """Deepest contact penetration (mm) over the converged states."""
+    return max((c.max_penetration for s in states for c in model.contact_summary(s.u).values()),
+               default=0.0)
 
 
 def solve(scene: object, progress: Callable[[object], None] | None = None) -> Solution:
