@@ -12,6 +12,12 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
 - acceptance guard against jumps to a distant branch: the predictor may not be longer than
   ``max_predictor_growth`` × the previous step, and the corrector may not move farther than
   ``max_correction_ratio`` × the predictor length from the predictor (norm ``‖(Δu, ψΔλ)‖``);
+- retrace / branch-jump guard (Crisfield's angle criterion applied to the converged step): the
+  displacement increment ``Δu`` of a converged step may not make an obtuse angle with the
+  previous step's (``cos < min_step_cosine``, 0 by default, in the system's inner product);
+  such a step went back along the path or jumped to another branch. It is rejected like a
+  failed one, and if the predictor itself pointed backwards the arc-length sign is flipped for
+  the retry (Feng, Perić & Owen's displacement-only predictor criterion);
 - a converged step whose state the model declares inadmissible (optional
   ``system.admissible(u)`` returning a non-empty reason, e.g. an inverted element) is rejected
   like a failed one, so the path never leaves the model's domain of physical meaning;
@@ -41,6 +47,7 @@ __all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linea
 
 CONTROLS = ("load", "displacement", "arc-length")
 INADMISSIBLE = "inadmissible state"  # prefix of the reason of a step rejected by admissible()
+RETRACE = "the step turns back"  # prefix of the reason of a step rejected by the retrace guard
 
 
 @dataclass
@@ -74,6 +81,10 @@ class PathOptions:
         ψ / ‖K(0)⁻¹ f_ref‖ in the arc-length norm (0: cylindrical arc).
     max_correction_ratio, max_predictor_growth
         Jump guards (see the module docstring).
+    min_step_cosine
+        Retrace guard: a converged step whose displacement increment has a cosine below this
+        with the previous step's is rejected (0: no turn by more than 90° in one step; ``-1``
+        switches the guard off).
     target_tol
         Relative tolerance on hitting ``until_value`` / ``until_load_factor`` by step cutting.
     target_accept
@@ -97,6 +108,7 @@ class PathOptions:
     arc_load_weight: float = 1.0
     max_correction_ratio: float = 1.0
     max_predictor_growth: float = 4.0
+    min_step_cosine: float = 0.0
     target_tol: float = 1e-6
     target_accept: float = 1e-3
 
@@ -113,6 +125,8 @@ class PathOptions:
             raise ValueError("until_value = 0 is the initial state")
         if self.max_steps < 1 or self.max_iterations < 1 or self.desired_iterations < 1:
             raise ValueError("max_steps, max_iterations and desired_iterations must be >= 1")
+        if not -1.0 <= self.min_step_cosine < 1.0:
+            raise ValueError(f"min_step_cosine must be in [-1, 1), got {self.min_step_cosine}")
 
     @property
     def driven_probe(self) -> str | None:
@@ -408,11 +422,45 @@ class _Follower:
         if dist > opt.max_correction_ratio * pred_len:
             return None, (f"corrector moved {dist:.3g} from a predictor of length {pred_len:.3g}"
                           f" (jump to another branch?)")
+        why = self._turns_back(res.u - last.u, du_pred)
+        if why:
+            return None, why
         if self.admissible is not None:
             why = self.admissible(res.u)
             if why:
                 return None, f"{INADMISSIBLE}: {why}"
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization), "converged"
+
+    def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
+        """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
+
+        Crisfield's angle criterion, used by the arc-length root choice *within* a step, applied
+        to the converged step against the previous one: along a regular equilibrium curve the
+        displacement increments of consecutive steps turn by a small angle (→ 0 with the step
+        length), whatever the sign of Δλ, since ``K du = dλ f_ref`` never gives ``du = 0`` on
+        the path. A step whose ``Δu`` makes an obtuse angle with the previous ``Δu`` went back
+        along the path or onto another branch. The displacement part only is compared (Feng,
+        Perić & Owen 1996): at a limit point Δλ changes sign legitimately, and with a large λ
+        weight ψ the weighted angle would turn by ~180° there. If the predictor itself pointed
+        backwards (``Δu_pred · Δu_prev < 0``, a wrong arc-length sign), the sign is flipped for
+        the retry.
+        """
+        if self.prev_step is None or self.opt.min_step_cosine <= -1.0:
+            return ""
+        prev = self.prev_step[0]
+        denom = math.sqrt(self.dot(du, du) * self.dot(prev, prev))
+        if not denom > 0.0:
+            return ""
+        cos = self.dot(du, prev) / denom
+        if cos >= self.opt.min_step_cosine:
+            return ""
+        pred_back = self.dot(du_pred, prev) < 0.0
+        if pred_back and self.opt.control == "arc-length":
+            self.sigma = -self.sigma
+        return (f"{RETRACE}: its displacement increment makes an angle of "
+                f"{math.degrees(math.acos(max(-1.0, min(1.0, cos)))):.0f}° with the previous "
+                f"step's (retrace or jump to another branch"
+                f"{'; predictor pointed backwards, sign flipped' if pred_back else ''})")
 
     def _crossings(self, last: PathState, trial: _Trial) -> list[tuple[float, str, float]]:
         """Targets crossed between ``last`` and ``trial``: (linear fraction, name, target)."""
