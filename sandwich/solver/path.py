@@ -48,6 +48,7 @@ __all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linea
 CONTROLS = ("load", "displacement", "arc-length")
 INADMISSIBLE = "inadmissible state"  # prefix of the reason of a step rejected by admissible()
 RETRACE = "the step turns back"  # prefix of the reason of a step rejected by the retrace guard
+TARGET_SUBSTEP_CUTS = 6  # halvings of the sub-increment when a crossed target is hit directly
 
 
 @dataclass
@@ -528,7 +529,74 @@ class _Follower:
                 if side == 1:
                     fb *= 0.5
                 side = 1
+        if abs(best_g) > tol:
+            # The arc through the bracket can lose its real roots on short arcs (Crisfield's
+            # quadratic); the target itself is then a better control equation: one corrector
+            # from ``last`` with "value(name) = target" (load or displacement control).
+            direct = self._attempt_target(name, target, last, t)
+            if direct is not None:
+                return direct, self.wnorm(direct.u - last.u,
+                                          direct.load_factor - last.load_factor), name
         return best, best_h, name
+
+    def _attempt_target(self, name: str, target: float, last: PathState,
+                        t: np.ndarray) -> _Trial | None:
+        """Reach ``value(name) = target`` from ``last`` under that control (None if it fails).
+
+        Load or displacement control of the crossed quantity, in sub-increments halved on a
+        failure (at most ``TARGET_SUBSTEP_CUTS`` times) and doubled after a success: a corrector
+        from the linear predictor over the whole remaining distance can fail where a contact
+        state changes within it (fig. 7 c4 at 40 elements). The sub-increments are corrector
+        internals; the accepted step goes from ``last`` to the target.
+        """
+        v0 = self._value(name, last.u, last.load_factor)
+        u, lam, tangent, done, frac, cuts, iters = last.u, last.load_factor, t, v0, 1.0, 0, 0
+        trial = None
+        while True:
+            goal = done + frac * (target - done)
+            trial = self._control_to(name, goal, u, lam, tangent)
+            if trial is None:
+                cuts += 1
+                frac *= 0.5
+                if cuts > TARGET_SUBSTEP_CUTS:
+                    return None
+                continue
+            iters += trial.iterations
+            u, lam, done = trial.u, trial.load_factor, goal
+            if frac == 1.0:
+                break
+            tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
+            frac = min(1.0, 2.0 * frac)
+        sigma = self.sigma
+        back = self._turns_back(u - last.u, u - last.u)
+        self.sigma = sigma  # the step is refused, not retried: keep the arc's sign
+        if back:
+            return None
+        if self.admissible is not None and self.admissible(u):
+            return None
+        return _Trial(u, lam, iters, trial.factorization)
+
+    def _control_to(self, name: str, goal: float, u: np.ndarray, lam: float,
+                    t: np.ndarray) -> _Trial | None:
+        """One corrector from (u, λ) with ``value(name) = goal`` as control equation."""
+        opt = self.opt
+        if name == "λ":
+            dlam, constraint = goal - lam, LoadConstraint(goal)
+        else:
+            c = self.c[name]
+            ct = self.dot(c, t)
+            if ct == 0.0 or not math.isfinite(ct):
+                return None
+            dlam = (goal - self.dot(c, u)) / ct
+            constraint = ProbeConstraint(c, goal, self.dot)
+        floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
+                 * max(abs(s.load_factor) for s in self.states))
+        settings = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations, psi=self.psi,
+                                  force_floor=floor)
+        res = newton_correct(self.system, u + dlam * t, lam + dlam, constraint, settings, u, lam)
+        if not res.converged or res.factorization is None:
+            return None
+        return _Trial(res.u, res.load_factor, res.iterations, res.factorization)
 
     def _near_target(self, name: str, s: PathState) -> str:
         """Message if a crossed target was missed by at most ``target_accept`` (relative)."""
