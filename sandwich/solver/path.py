@@ -49,6 +49,8 @@ CONTROLS = ("load", "displacement", "arc-length")
 INADMISSIBLE = "inadmissible state"  # prefix of the reason of a step rejected by admissible()
 RETRACE = "the step turns back"  # prefix of the reason of a step rejected by the retrace guard
 TARGET_SUBSTEP_CUTS = 6  # halvings of the sub-increment when a crossed target is hit directly
+RESCUE_FRACTION = 0.05  # probe rescue: tried once the arc is cut below this × its largest so far
+RESCUE_MEMORY = 5  # accepted steps remembered for the rescue step's probe change
 
 
 @dataclass
@@ -86,6 +88,12 @@ class PathOptions:
         Retrace guard: a converged step whose displacement increment has a cosine below this
         with the previous step's is rejected (0: no turn by more than 90° in one step; ``-1``
         switches the guard off).
+    probe_rescue
+        Arc-length with an ``until_probe``: when the arc collapses at a critical point (a failed
+        step cut below ``RESCUE_FRACTION`` of the largest increment accepted so far), try one
+        step under control of that probe, as long as its largest change over the last
+        ``RESCUE_MEMORY`` steps, towards the target (what a testing machine driving that point
+        does); the message counts such steps.
     target_tol
         Relative tolerance on hitting ``until_value`` / ``until_load_factor`` by step cutting.
     target_accept
@@ -110,6 +118,7 @@ class PathOptions:
     max_correction_ratio: float = 1.0
     max_predictor_growth: float = 4.0
     min_step_cosine: float = 0.0
+    probe_rescue: bool = True
     target_tol: float = 1e-6
     target_accept: float = 1e-3
 
@@ -197,6 +206,7 @@ class _Follower:
         self.c = {n: np.asarray(system.probe_vector(n), dtype=float) for n in names}
         self.f_ref = np.asarray(system.f_ref, dtype=float)
         self.states: list[PathState] = []
+        self.rescues: list[int] = []
         admissible = getattr(system, "admissible", None)
         self.admissible = admissible if callable(admissible) else None
 
@@ -215,6 +225,10 @@ class _Follower:
             self.progress(state)
 
     def finish(self, reached: bool, message: str) -> PathResult:
+        if self.rescues:
+            message += (f" ({len(self.rescues)} step(s) taken under control of "
+                        f"{self.opt.until_probe} where the arc collapsed at a critical point: "
+                        f"step(s) {', '.join(map(str, self.rescues))})")
         return PathResult(self.states, reached, message, find_limit_points(self.states))
 
     # -- the run -------------------------------------------------------------------------------
@@ -246,6 +260,8 @@ class _Follower:
             raise ValueError(f"need 0 < min_increment <= increment <= max_increment, got "
                              f"{h_min}, {h}, {h_max}")
         self.prev_step: tuple[np.ndarray, float] | None = None
+        self.recent: list[tuple[float, float]] = []  # (increment, until-probe change) accepted
+        self.peak = 0.0  # largest accepted increment so far
         self.sigma = 1.0 if self.lam_est >= 0 else -1.0
         if opt.control == "displacement":  # move the probe the way the load would move it
             ct = self.dot(self.c[opt.driven_probe], t)
@@ -259,6 +275,7 @@ class _Follower:
             if opt.control == "arc-length":
                 self.sigma = self._arc_direction(t, last)
             cuts = 0
+            rescued = False
             while True:
                 h_try, direct = self._clip_to_target(h, last)
                 trial, reason = self._attempt(h_try, last, t)
@@ -266,6 +283,13 @@ class _Follower:
                     break
                 h = 0.5 * h_try
                 cuts += 1
+                if not rescued and self._rescue_due(cuts, h):
+                    rescued = True
+                    trial, direct = self._probe_rescue(last, t)
+                    if trial is not None:
+                        self.rescues.append(step)
+                        h_try = self.wnorm(trial.u - last.u, trial.load_factor - last.load_factor)
+                        break
                 if h < h_min:
                     hint = ""
                     if reason.startswith(INADMISSIBLE):
@@ -289,6 +313,10 @@ class _Follower:
             if not direct:
                 trial, h_try, crossed = self._hit_crossed_target(trial, h_try, last, t)
             self.prev_step = (trial.u - last.u, trial.load_factor - last.load_factor)
+            if opt.until_probe is not None:
+                dv = self._value(opt.until_probe, trial.u, 0.0) - last.probes[opt.until_probe]
+                self.recent = [*self.recent, (h_try, dv)][-RESCUE_MEMORY:]
+                self.peak = max(self.peak, h_try)
             fac = trial.factorization
             self.accept(trial.u, trial.load_factor, trial.iterations, fac.negative_pivots, cuts)
             try:
@@ -538,6 +566,29 @@ class _Follower:
                 return direct, self.wnorm(direct.u - last.u,
                                           direct.load_factor - last.load_factor), name
         return best, best_h, name
+
+    def _rescue_due(self, cuts: int, h: float) -> bool:
+        """Whether the arc has collapsed enough to try :meth:`_probe_rescue`."""
+        opt = self.opt
+        if not (opt.probe_rescue and opt.control == "arc-length" and opt.until_probe
+                and self.recent and cuts >= 1):
+            return False
+        return h < RESCUE_FRACTION * self.peak
+
+    def _probe_rescue(self, last: PathState, t: np.ndarray) -> tuple[_Trial | None, bool]:
+        """One step under control of the until probe across a critical point.
+
+        Size: the largest recent change of the probe, towards the target (clipped to it).
+        Returns the step (None if it fails or turns back) and whether it hit the target.
+        """
+        name, goal = self.opt.until_probe, self.opt.until_value
+        v = last.probes[name]
+        size = max(abs(dv) for _, dv in self.recent)
+        if size == 0.0:
+            return None, False
+        direct = size >= abs(goal - v)
+        target = goal if direct else v + math.copysign(size, goal - v)
+        return self._attempt_target(name, target, last, t), direct
 
     def _attempt_target(self, name: str, target: float, last: PathState,
                         t: np.ndarray) -> _Trial | None:
