@@ -210,9 +210,10 @@ MAP_CONVERGED_EDGES = [  # cheap at 240 elements (~1-2 s each unloaded): default
     ("stiffness", 1e-5), ("thickness", 100), ("slenderness", 20),
     pytest.param("debond", 0.9, marks=pytest.mark.heavy),  # 255 steps
     pytest.param("load", 2.0, marks=[pytest.mark.heavy, pytest.mark.xfail(strict=True, reason=(
-        "at 240 elements the arc-length path turns back at the load maximum (λ ≈ 2292, "
-        "w ≈ −28.7 mm), retraces to λ ≈ 1510, later runs through λ < 0 (w_top up to +59 mm) "
-        "and only then reaches −30 mm (327 steps, 110 cuts); docs/extremes.md"))]),
+        "at 240 elements the path reaches a load maximum (λ ≈ 2047, w ≈ −27.3 mm) next to a "
+        "bifurcation (negative pivots 1 → 2 → 3) and runs back near the loading branch; going "
+        "on to −30 mm needs branch switching, which the follower does not do; docs/extremes.md "
+        "point 7"))]),
 ]
 
 
