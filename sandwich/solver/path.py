@@ -439,10 +439,7 @@ class _Follower:
             if pred_len > opt.max_predictor_growth * prev_len:
                 return None, (f"predictor {pred_len:.3g} longer than {opt.max_predictor_growth}"
                               f" × the previous step {prev_len:.3g}")
-        floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
-                 * max(abs(s.load_factor) for s in self.states))
-        settings = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations, psi=self.psi,
-                                  force_floor=floor)
+        settings = self._newton_settings()
         res = newton_correct(self.system, last.u + du_pred, last.load_factor + dlam, constraint,
                              settings, last.u, last.load_factor)
         if not res.converged or res.factorization is None:
@@ -459,6 +456,13 @@ class _Follower:
             if why:
                 return None, f"{INADMISSIBLE}: {why}"
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization), "converged"
+
+    def _newton_settings(self) -> NewtonSettings:
+        """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far."""
+        floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
+                 * max(abs(s.load_factor) for s in self.states))
+        return NewtonSettings(tol=self.opt.tol, max_iterations=self.opt.max_iterations,
+                              psi=self.psi, force_floor=floor)
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
@@ -630,7 +634,6 @@ class _Follower:
     def _control_to(self, name: str, goal: float, u: np.ndarray, lam: float,
                     t: np.ndarray) -> _Trial | None:
         """One corrector from (u, λ) with ``value(name) = goal`` as control equation."""
-        opt = self.opt
         if name == "λ":
             dlam, constraint = goal - lam, LoadConstraint(goal)
         else:
@@ -640,11 +643,8 @@ class _Follower:
                 return None
             dlam = (goal - self.dot(c, u)) / ct
             constraint = ProbeConstraint(c, goal, self.dot)
-        floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
-                 * max(abs(s.load_factor) for s in self.states))
-        settings = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations, psi=self.psi,
-                                  force_floor=floor)
-        res = newton_correct(self.system, u + dlam * t, lam + dlam, constraint, settings, u, lam)
+        res = newton_correct(self.system, u + dlam * t, lam + dlam, constraint,
+                             self._newton_settings(), u, lam)
         if not res.converged or res.factorization is None:
             return None
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization)
