@@ -115,6 +115,7 @@ NORMAL_SIGN = {"top": 1.0, "bottom": -1.0}
 DEFAULT_REACH = 1.0  # mm: closest-point search covers at least this far on each side of a node
 PROJECTION_TOL = 1e-12  # |Δξ| at which the projection Newton stops
 PROJECTION_MAX_ITERATIONS = 30
+PROJECTION_RESIDUAL_TOL = 1e-9  # a candidate counts if |φ| / |X_ξ|² (≈ its remaining |Δξ|) is below
 IN_SEGMENT_TOL = 1e-10  # ξ ∈ [−tol, 1 + tol] counts as on the segment
 
 # d(Δu, Δw, a = 1 + u_c,x, c = w_c,x) / d(pair DOFs): the chain from gap variables to DOFs.
@@ -390,36 +391,61 @@ def _scatter(
                           c.outside[rows])
 
 
+def _projection_residual(ξ, l, xa, U, W, xs, ws):
+    """φ = r·X_ξ, φ_ξ and X_ξ = (a, c) on every candidate segment at ξ."""
+    N = hermite_basis(ξ, l, orders=3)  # (3, m, s, 4)
+    r1 = xs - (xa + l * ξ + np.sum(N[0] * U, -1))
+    r2 = ws - np.sum(N[0] * W, -1)
+    a, c = l + np.sum(N[1] * U, -1), np.sum(N[1] * W, -1)
+    aξ, cξ = np.sum(N[2] * U, -1), np.sum(N[2] * W, -1)
+    return r1 * a + r2 * c, -(a**2 + c**2) + r1 * aξ + r2 * cξ, a, c
+
+
 def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     m = pairs.size
     xa, l, U, W, xs, ws = _segment_geometry(pairs, u_full)
     x_node = pairs.x[pairs.nodes][:, None]
-    # Newton for φ(ξ) = r·X_ξ = 0 on every candidate segment, from the node's own x (clamped)
+    valid = pairs.segment_valid
+    # Newton for φ(ξ) = r·X_ξ = 0 on every candidate segment, from the node's own x (clamped);
+    # iterations stop when every candidate that can still hold its projection has settled
     ξ = np.clip((x_node - xa) / l, 0.0, 1.0)
     for _ in range(PROJECTION_MAX_ITERATIONS):
-        N = hermite_basis(ξ, l, orders=3)  # (3, m, s, 4)
-        r1 = xs - (xa + l * ξ + np.sum(N[0] * U, -1))
-        r2 = ws - np.sum(N[0] * W, -1)
-        a, c = l + np.sum(N[1] * U, -1), np.sum(N[1] * W, -1)
-        aξ, cξ = np.sum(N[2] * U, -1), np.sum(N[2] * W, -1)
-        φ = r1 * a + r2 * c
-        φξ = -(a**2 + c**2) + r1 * aξ + r2 * cξ
+        φ, φξ, a, c = _projection_residual(ξ, l, xa, U, W, xs, ws)
         φξ = np.where(φξ < -1e-3 * (a**2 + c**2), φξ, -(a**2 + c**2))  # keep the descent
         new = np.clip(ξ + np.clip(-φ / φξ, -0.5, 0.5), -0.5, 1.5)
-        change = np.max(np.abs(new - ξ), initial=0.0)
+        change = np.max(np.abs(new - ξ), initial=0.0, where=valid)
         ξ = new
         if change < PROJECTION_TOL:
             break
-    # choose: a segment holding its projection, the nearest if several; else the least outside
-    inside = pairs.segment_valid & (ξ >= -IN_SEGMENT_TOL) & (ξ <= 1 + IN_SEGMENT_TOL)
+    # a candidate counts only if its Newton converged (|φ| / |X_ξ|² = the remaining |Δξ|) and
+    # its projection lies on the segment
+    φ, _, a, c = _projection_residual(ξ, l, xa, U, W, xs, ws)
+    converged = np.abs(φ) <= PROJECTION_RESIDUAL_TOL * (a**2 + c**2)
+    inside = valid & converged & (ξ >= -IN_SEGMENT_TOL) & (ξ <= 1 + IN_SEGMENT_TOL)
     N = hermite_basis(ξ, l, orders=1)
     r1 = xs - (xa + l * ξ + np.sum(N[0] * U, -1))
     r2 = ws - np.sum(N[0] * W, -1)
     dist = np.hypot(r1, r2)
-    out_by = np.where(pairs.segment_valid, l * np.maximum(np.maximum(-ξ, ξ - 1), 0.0), np.inf)
-    score = np.where(inside, dist, np.inf)
     outside = ~inside.any(axis=1)
-    seg = np.where(outside, np.argmin(out_by, axis=1), np.argmin(score, axis=1))
+    seg = np.argmin(np.where(inside, dist, np.inf), axis=1)
+    if outside.any():
+        # No projection on the searched curve: the nearer end of the searched stretch, at fixed
+        # ξ (0 on the first valid segment, 1 on the last). The gap there, n·r, is the distance
+        # to the tangent line at that end; it equals the projection's gap when the projection
+        # leaves through that end (r ∥ n there), so the gap stays continuous (and C¹: g̃_ξ = 0)
+        first = np.argmax(valid, axis=1)
+        last = valid.shape[1] - 1 - np.argmax(valid[:, ::-1], axis=1)
+        ends = []
+        for j, e in ((first, 0.0), (last, 1.0)):
+            r = np.arange(m)
+            Ne = hermite_basis(np.full(m, e), l[r, j], orders=1)[0]
+            Xe = xa[r, j] + l[r, j] * e + np.sum(Ne * U[r, j], -1)
+            ends.append(np.hypot(xs[:, 0] - Xe, ws[:, 0] - np.sum(Ne * W[r, j], -1)))
+        right = ends[1] < ends[0]
+        end_seg = np.where(right, last, first)
+        seg = np.where(outside, end_seg, seg)
+        ξ = ξ.copy()
+        ξ[outside, seg[outside]] = np.where(right, 1.0, 0.0)[outside]
     rows = np.arange(m)
     ξs, ls, Us, Ws = ξ[rows, seg], l[rows, seg], U[rows, seg], W[rows, seg]
     N = hermite_basis(ξs, ls)  # (4, m, 4)
@@ -449,7 +475,8 @@ def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     dφ = np.stack([a, c, r1, r2], axis=-1)  # ∂φ/∂(r1, r2, a, c), φ = r1 a + r2 c
     Φ = (dφ[:, None, :] @ J)[:, 0]
     ξq = -Φ[:, 1:] / Φ[:, :1]  # dξ/dq from φ(ξ(q), q) = 0
-    grad = G[:, 1:]  # + g̃_ξ ξ_q, zero at the projection (g̃_ξ = s_n r·n_ξ ∝ φ)
+    ξq[outside] = 0.0  # beyond the searched stretch ξ stays at its end
+    grad = G[:, 1:]  # + g̃_ξ ξ_q, zero at the projection (g̃_ξ = s_n r·n_ξ ∝ φ) and outside
     hess = (H[:, 1:, 1:] + H[:, 1:, :1] * ξq[:, None, :] + ξq[:, :, None] * H[:, :1, 1:]
             + H[:, :1, :1] * ξq[:, :, None] * ξq[:, None, :])
     # the block columns of the segment's 10 DOFs

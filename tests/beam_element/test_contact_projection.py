@@ -319,3 +319,78 @@ def test_groups_by_search_width_give_the_ungrouped_force_and_tangent():
     assert g1 == pytest.approx(g2, abs=1e-15) and np.allclose(list(g2.values()), gap, atol=1e-12)
     assert np.allclose(F1, F2, rtol=0, atol=1e-12 * np.abs(F2).max())
     assert np.allclose(K1, K2, rtol=0, atol=1e-12 * np.abs(K2).max())
+
+
+# A uniform mesh of 0.25 mm elements: a 1 mm reach spans four segments on each side of a node,
+# and a sliding of 2 mm takes the projection well beyond them (fig. 7 c3 at 240 elements: the
+# core's bottom boundary slides ~1.3 mm along the debonded face at the clamp).
+XU = np.linspace(0.0, 12.0, 49)
+NODE_U = 24  # x = 6: searches the core over [5, 7]
+
+
+def _sliding_state(interface, d, gap):
+    """Node NODE_U at X(x_i + d) + gap n on a rotated, wavy core; the other nodes untouched."""
+    nodes = np.arange(1, XU.size - 1)
+    slide, gaps = np.zeros(nodes.size), np.full(nodes.size, 0.1)
+    slide[NODE_U - 1], gaps[NODE_U - 1] = d, gap
+    return _state(interface, slide, gaps, x=XU, nodes=nodes)
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_gap_continuous_when_the_projection_leaves_the_searched_segments(interface):
+    # regression: beyond the reach the old fallback extrapolated the "least outside" segment,
+    # whose Newton stalled at ξ = 1.5 on several segments alike; the pick among them flipped with
+    # round-off and the gap jumped (c3, 240 elements: 0.052 → −0.011 mm, ‖f_int‖ by 2e5 N)
+    pairs = contact_pairs(interface, np.array([NODE_U]), XU, 60.0, search="closest-point",
+                          reach=1.0)
+    g0 = -1e-3
+    ds = np.linspace(-2.0, 2.0, 801)  # steps of 5e-3 mm
+    ks = [pair_kinematics(pairs, _sliding_state(interface, d, g0)) for d in ds]
+    gaps = np.array([k.gap[0] for k in ks])
+    outside = np.array([bool(k.outside[0]) for k in ks])
+    within = np.abs(ds) < 1.0 - 1e-9
+    assert not outside[within].any() and outside[np.abs(ds) > 1.0 + 1e-9].all()
+    assert np.allclose(gaps[within], g0, rtol=0, atol=1e-12)  # exact while searched
+    # continuous: beyond the reach the gap is the distance to the tangent line at the searched
+    # stretch's end, which departs from g0 with the core's curvature (slope ≤ 0.03 here; the old
+    # fallback jumped by 0.055 mm at d = 1.125)
+    assert np.max(np.abs(np.diff(gaps))) < 0.1 * (ds[1] - ds[0])
+    # and C¹ at the exit: the gradient on either side of |d| = reach agrees
+    for edge in (-1.0, 1.0):
+        grads = []
+        for d in (edge - 1e-7, edge + 1e-7):
+            k = pair_kinematics(pairs, _sliding_state(interface, d, g0))
+            grads.append(np.bincount(pairs.block_dofs[0], weights=k.grad[0],
+                                     minlength=NODE_DOFS * XU.size))
+        assert np.linalg.norm(grads[1] - grads[0]) < 1e-5 * np.linalg.norm(grads[0])
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_consistent_tangent_beyond_the_searched_segments(interface):
+    pairs = contact_pairs(interface, np.array([NODE_U]), XU, 60.0, search="closest-point",
+                          reach=1.0)
+    u = _sliding_state(interface, 1.4, -2e-2)
+    f, K, p, k = penalty_response(pairs, u, EPS, S)
+    assert k.outside[0] and p[0] > 0
+    d = pairs.block_dofs[0]
+    n = NODE_DOFS * XU.size
+
+    def glob(local):
+        if local.ndim == 1:
+            return np.bincount(d, weights=local, minlength=n)
+        out = np.zeros((n, n))
+        np.add.at(out, (d[:, None], d[None, :]), local)
+        return out
+
+    G, F, KK = glob(k.grad[0]), glob(f[0]), glob(K[0])
+    h = 1e-6
+    for j in np.unique(d):
+        du = np.zeros_like(u)
+        du[j] = h
+        fp, _, _, kp = penalty_response(pairs, u + du, EPS, S)
+        fm, _, _, km = penalty_response(pairs, u - du, EPS, S)
+        assert (kp.gap[0] - km.gap[0]) / (2 * h) == pytest.approx(G[j], abs=1e-8 * np.abs(G).max())
+        fd = (glob(fp[0]) - glob(fm[0])) / (2 * h)
+        assert np.allclose(KK[:, j], fd, rtol=0, atol=1e-6 * np.abs(KK).max())
+        W = pairs.area[0] * (contact_energy(kp.gap[0], EPS, S) - contact_energy(km.gap[0], EPS, S))
+        assert W / (2 * h) == pytest.approx(F[j], abs=1e-6 * np.abs(F).max())
