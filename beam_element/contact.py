@@ -3,14 +3,14 @@
 Pairing. Nodes strictly inside a debond are untied; at each of them the face's inner surface
 point (master) meets the core's boundary curve (slave). Two searches (``contact_pairs(search=)``):
 
-* ``"closest-point"`` (option ``contact_search`` of :func:`beam_element.model.build_model`,
-  whose default is still same-x, see docs/beam_element.md): node-to-segment. The master point
-  is projected on the deformed core boundary curve, the gap is measured along the slave's
+* ``"closest-point"`` (the default of ``contact_search`` in
+  :func:`beam_element.model.build_model`, docs/contact_search.md): node-to-segment. The master
+  point is projected on the deformed core boundary curve, the gap is measured along the slave's
   deformed normal at the projection, and the linearisation includes the motion of the
   projection point (below).
-* ``"same-x"`` (default): node-to-node, the core boundary point of the *same material
-  coordinate x*. It assumes small relative sliding; the sliding s = t·Δ is returned so a user
-  can check it.
+* ``"same-x"`` (option; the model's earlier default, and the default of :func:`contact_pairs`):
+  node-to-node, the core boundary point of the *same material coordinate x*. It assumes small
+  relative sliding; the sliding s = t·Δ is returned so a user can check it.
 
 Closest point (node-to-segment; cf. Wriggers, Computational Contact Mechanics, ch. 4 and 8, the
 2D node-to-segment element on a curved segment; written here via the implicit function ξ(q)).
@@ -27,12 +27,17 @@ X_ξ = (a, c) = (l + Σ N'_k U_k, Σ N'_k W_k), the projection solves
     φ(ξ, q) = r · X_ξ = 0          (Newton: ξ ← ξ − φ/φ_ξ, φ_ξ = −|X_ξ|² + r·X_ξξ),
 
 vectorised over pairs and candidate segments (those within ``reach`` mm on each side of the node,
-at least one per side; a fixed maximum of iterations, stopping when every |Δξ| < 1e-12). The
-chosen segment is one whose ξ lies in [0, 1], the nearest (smallest |r|) if several do; the core
-boundary is C¹ across nodes (shared slope DOFs), so at a node both neighbours give the same point.
-If none does (sliding beyond the searched reach) the segment least outside is extrapolated and
-the pair is flagged ``outside``. The gap along the slave's deformed normal n = s_n (−c, a)/ℓ,
-ℓ = |X_ξ|, is
+at least one per side; at most 30 iterations, stopping when every |Δξ| < 1e-12). A candidate
+counts only if its Newton converged (|φ|/|X_ξ|² ≤ 1e-9) to a ξ in [0, 1]; the chosen one is the
+nearest (smallest |r|) of those. The core boundary is C¹ across nodes (shared slope DOFs), so at a
+node both neighbours give the same point, and between two distinct projections the nearest rule
+switches at equal distance, where g = ±|r| agrees. If no candidate counts (sliding beyond the
+searched reach) the pair is flagged ``outside`` and held at the nearer end of the searched
+stretch at fixed ξ (ξ_q = 0): its gap n·r is the distance to the tangent line at that end, equal
+to the projection's gap when the projection leaves through that end (r ∥ n there), so g stays
+continuous and C¹ (g̃_ξ = 0 there) along any motion (docs/contact_search.md: the earlier
+fallback, an extrapolated "least outside" segment, made the c3 cantilever's internal force jump).
+The gap along the slave's deformed normal n = s_n (−c, a)/ℓ, ℓ = |X_ξ|, is
 
     g̃(ξ, q) = n · r = s_n (a r₂ − c r₁)/ℓ,      g(q) = g̃(ξ(q), q),
 
