@@ -10,6 +10,7 @@ slot each local entry lands in and with which sign — is computed once; assembl
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -34,6 +35,25 @@ class ReducedPattern:
         values = np.concatenate([b.reshape(-1) for b in blocks])[self.keep]
         data = np.bincount(self.slot, weights=self.weight * values, minlength=self.indices.size)
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+
+    @cached_property
+    def family_slots(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        """Per block family, ``(slots, signs)`` of shape ``(B, n, n)``, for in-place assembly.
+
+        Each local entry's CSR slot (−1 where it is eliminated) and sign product
+        (:func:`beam_element.kernels.layer_assemble`). Computed on first use, then kept.
+        """
+        pos = np.cumsum(self.keep) - 1  # index into slot/weight of each kept entry
+        out, offset = [], 0
+        for d in self.block_dofs:
+            B, n = d.shape
+            k = self.keep[offset:offset + B * n * n]
+            idx = pos[offset:offset + B * n * n]
+            slots = np.where(k, self.slot[idx], -1).astype(np.int32).reshape(B, n, n)
+            signs = np.where(k, self.weight[idx], 0).astype(np.int8).reshape(B, n, n)
+            out.append((slots, signs))
+            offset += B * n * n
+        return tuple(out)
 
 
 def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPattern:

@@ -77,6 +77,7 @@ class BeamModel:
     max_sliding_seen: float = 0.0
     # (u, f, K or None, layer states of u): the tangent at the last force's u reuses its states.
     _cache: tuple | None = None
+    use_kernels = True  # class attribute, not a field: False forces the NumPy reference path
 
     def __post_init__(self) -> None:
         e = np.arange(self.mesh.n_elements)[:, None]
@@ -121,12 +122,28 @@ class BeamModel:
         return float(np.finfo(float).eps * np.linalg.norm(absK @ np.abs(u)))
 
     def factorize(self, K: sp.spmatrix) -> object:
-        """Sparse LU of the tangent (with inertia when the shared backend provides it)."""
+        """Envelope LDLᵀ of the tangent with its inertia (:mod:`sandwich.solver.envelope`).
+
+        The symbolic part (ordering, envelope) is computed once per sparsity pattern and kept;
+        SuperLU (:class:`sandwich.solver.sparse.SparseFactorization`) is the fallback when the
+        pivot-free LDLᵀ is untrustworthy, or when numba is not installed.
+        """
         try:
-            from sandwich.solver.sparse import SparseFactorization
-        except ImportError:  # the shared backend is not there yet
-            return _SpluFactorization(K)
-        return SparseFactorization(K)
+            from sandwich.solver.envelope import EnvelopeStructure, factorize_envelope
+        except ImportError:  # no numba (or an older shared backend)
+            try:
+                from sandwich.solver.sparse import SparseFactorization
+            except ImportError:
+                return _SpluFactorization(K)
+            return SparseFactorization(K)
+        K = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
+        known = self.__dict__.setdefault("_envelopes", [])  # the model's pattern, linear ones
+        structure = next((s for s in known if s.matches(K)), None)
+        if structure is None:
+            structure = EnvelopeStructure.of(K)
+            known.append(structure)
+            del known[:-4]
+        return factorize_envelope(K, structure)
 
     def probe_vector(self, name: str) -> np.ndarray:
         """C on the free DOFs with probe value c · u (mm)."""
@@ -161,12 +178,26 @@ class BeamModel:
         u_full = self.expand(u)
         f_full, states = self._forces(u_full)
         f = self.dof_map.reduce(f_full)
-        K = self.pattern.assemble(self._tangent_blocks(u_full, states)) if tangent else None
+        if isinstance(states, _Assembled):  # compiled path: the tangent came with the force
+            K = states.K
+        else:
+            K = self.pattern.assemble(self._tangent_blocks(u_full, states)) if tangent else None
         self._cache = (np.array(u, dtype=float, copy=True), f, K, states)
         return f, K
 
-    def _forces(self, u_full: np.ndarray) -> tuple[np.ndarray, dict[str, list[LayerState]]]:
-        """Internal force on the full DOFs and the layer states (per chunk) it came from."""
+    def _forces(
+        self, u_full: np.ndarray, compiled: bool | None = None
+    ) -> tuple[np.ndarray, dict[str, list[LayerState]] | _Assembled]:
+        """Internal force on the full DOFs and the layer states (per chunk) it came from.
+
+        With the compiled kernels (:mod:`beam_element.kernels`; ``compiled`` defaults to
+        :attr:`use_kernels` and numba being importable) the reduced tangent is assembled in the
+        same pass and returned instead of the states: a Newton iteration asks for the tangent
+        at every u whose residual it evaluates (fig. 5: 139 forces, 140 tangents).
+        """
+        kernels = _kernels() if (self.use_kernels if compiled is None else compiled) else None
+        if kernels is not None:
+            return self._compiled_forces(u_full, kernels)
         forces, states = [], {}
         lengths = self.mesh.lengths
         u_e = u_full[self.element_dofs]
@@ -178,6 +209,32 @@ class BeamModel:
         for pairs in self.pairs:
             forces.append(penalty_response(pairs, u_full, self.penalty, self.smoothing)[0])
         return scatter_vector(u_full.size, self.block_dofs, forces), states
+
+    def _compiled_forces(
+        self, u_full: np.ndarray, kernels: object
+    ) -> tuple[np.ndarray, _Assembled]:
+        """Force and reduced tangent in one pass: layers by the kernels, contact by NumPy."""
+        slots = self.pattern.family_slots  # block families: the layers, then the contact pairs
+        data = np.zeros(self.pattern.indices.size)
+        lengths = self.mesh.lengths
+        u_e = u_full[self.element_dofs]
+        forces = []
+        for i, name in enumerate(LAYERS):
+            op = self.layers[name]
+            if kernels.supports(op):
+                forces.append(kernels.layer_assemble(op, u_e, lengths, self.width, *slots[i],
+                                                     data))
+                continue
+            st = layer_state(op, u_e, lengths, self.width)  # membrane_average: NumPy path
+            forces.append(st.f)
+            kernels.scatter_blocks(layer_tangent(op, st, self.products[name]), *slots[i], data)
+        for j, pairs in enumerate(self.pairs, start=len(LAYERS)):
+            f, K, _, _ = penalty_response(pairs, u_full, self.penalty, self.smoothing)
+            forces.append(f)
+            kernels.scatter_blocks(np.ascontiguousarray(K), *slots[j], data)
+        n = self.pattern.n
+        K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
+        return scatter_vector(u_full.size, self.block_dofs, forces), _Assembled(K)
 
     def _tangent_blocks(
         self, u_full: np.ndarray, states: dict[str, list[LayerState]]
@@ -192,8 +249,11 @@ class BeamModel:
     def full_response(
         self, u_full: np.ndarray, tangent: bool = True
     ) -> tuple[np.ndarray, list[np.ndarray]]:
-        """Internal force on the full DOFs and the local tangent blocks (layers, then contact)."""
-        f_full, states = self._forces(u_full)
+        """Internal force on the full DOFs and the local tangent blocks (layers, then contact).
+
+        Evaluated by the NumPy reference path (:mod:`beam_element.element`).
+        """
+        f_full, states = self._forces(u_full, compiled=False)
         return f_full, (self._tangent_blocks(u_full, states) if tangent else [])
 
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
@@ -216,6 +276,27 @@ class BeamModel:
     def penetration_bound(self) -> float:
         """Allowed penetration (mm): PENETRATION_BOUND × the thinner face."""
         return PENETRATION_BOUND * min(self.face_thickness.values())
+
+
+@dataclass(frozen=True)
+class _Assembled:
+    """What the compiled path keeps of a force evaluation: the reduced tangent at its u."""
+
+    K: sp.csr_matrix
+
+
+_KERNELS: list = []
+
+
+def _kernels() -> object | None:
+    """:mod:`beam_element.kernels` (imported on first use), or None without numba."""
+    if not _KERNELS:
+        try:
+            from beam_element import kernels
+        except ImportError:
+            kernels = None
+        _KERNELS.append(kernels)
+    return _KERNELS[0]
 
 
 class _SpluFactorization:

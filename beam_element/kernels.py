@@ -1,0 +1,368 @@
+"""Compiled internal force (eq. 19) and consistent tangent (eqs. 24-25) of a layer, in one pass.
+
+The same mechanics as :mod:`beam_element.element` (the NumPy reference, kept and tested
+against this file), evaluated by a numba kernel that loops once over elements × Gauss points
+and, per point, forms the gradients (eq. 15), the Green-Lagrange strains and the second
+Piola-Kirchhoff stresses, adds the point's share of the force and, if asked, of the tangent:
+
+- B = Φ R with R = (N,η, N,ξ, M,η, M,ξ) the reference rows (eq. 17, see
+  :func:`beam_element.kinematics.strain_coefficients`), so K = Σ_g Σ_kl H_kl R_kᵀ R_l with the
+  4×4 matrix H = dV ΦᵀCΦ (material part, eq. 24) plus the stresses of eq. (25) on its
+  (N,η N,η), (N,ξ N,ξ), (N,η N,ξ) pairs and their M twins (geometric part);
+- N rows vanish off the layer's u columns and M rows off its w columns
+  (:attr:`~beam_element.layer_operators.LayerOperators.u_columns`), so K splits into uu, ww and
+  uw blocks; uu and ww are symmetric and only their upper triangles are accumulated.
+
+Everything is generic in the layer's DOF count n and point count G, read from the
+:class:`~beam_element.layer_operators.LayerOperators` arrays (rows, ``u_columns``, stiffness,
+weights, dofs): a layer with more DOFs or a composite rule needs no change here. The only
+per-call memory is the output; per-element work arrays have the size of one element's blocks.
+
+The tangent is either written as blocks ``(E, n, n)`` (:func:`layer_response`, the
+:mod:`beam_element.element` interface) or scattered straight into the values of the reduced CSR
+matrix through a precomputed slot map (:func:`layer_assemble`, used by the model), which skips
+the blocks and their concatenation. Layers with the ``membrane_average`` option use the NumPy
+path.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from beam_element.layer_operators import LayerOperators
+from sandwich.solver.jit import njit
+
+__all__ = ["KernelOperators", "kernel_operators", "layer_assemble", "layer_response",
+           "point_flops", "scatter_blocks", "supports"]
+
+
+@dataclass(frozen=True)
+class KernelOperators:
+    """A layer's rows in the layout of the kernel (computed once per layer).
+
+    With R_k (k = N,η N,ξ M,η M,ξ) the reference rows at point g, H the symmetric 4×4 point
+    matrix and the field split, the element tangent is
+
+        K_uu[a ≤ b] = Σ_g H00 N0a N0b + H11 N1a N1b + H01 (N0a N1b + N1a N0b)   (Quu rows)
+        K_ww[a ≤ b] = the same with (M, H22, H33, H23)                          (Qww rows)
+        K_uw[a, b]  = Σ_g Σ_{k ∈ N, l ∈ M} H_kl N_ka M_lb                       (Quw rows)
+
+    so over a block of elements it is a product (elements × 3G) · (3G × packed pairs): one
+    BLAS GEMM per field pair, with Q element-independent.
+    """
+
+    NuT: np.ndarray  # (n_u, 2G): [N,η | N,ξ]ᵀ on the u columns (gradients: U @ NuT)
+    MwT: np.ndarray  # (n_w, 2G)
+    Nu: np.ndarray  # (2G, n_u): force f_u = c @ Nu
+    Mw: np.ndarray  # (2G, n_w)
+    Quu: np.ndarray  # (3G, n_u (n_u + 1) / 2), rows (00 | 11 | 01) per point
+    Qww: np.ndarray  # (3G, n_w (n_w + 1) / 2), rows (22 | 33 | 23)
+    Quw: np.ndarray  # (4G, n_u n_w), rows (02 | 03 | 12 | 13)
+    pu: np.ndarray  # (2, n_u (n_u + 1) / 2): (a, b) of each packed uu pair, a ≤ b
+    pw: np.ndarray  # (2, n_w (n_w + 1) / 2)
+    ucols: np.ndarray  # (n_u,) positions of the u columns in the layer's DOFs
+    wcols: np.ndarray  # (n_w,)
+    dofs: np.ndarray  # (n,) element-local DOF indices
+    x_slope: np.ndarray  # (n,) bool
+    weight: np.ndarray  # (G,)
+    stiffness: np.ndarray  # (3, 3)
+    thickness: float
+
+
+def supports(op: LayerOperators) -> bool:
+    """Whether the kernel evaluates ``op`` (not with the ``membrane_average`` option)."""
+    return not op.membrane_average
+
+
+def _packed_products(A0, A1, B0, B1, symmetric):
+    """Rows of Q for one field pair: per point, the products of the k- and l-rows."""
+    if symmetric:
+        a, b = np.triu_indices(A0.shape[1])
+        q = [A0[:, a] * A0[:, b], A1[:, a] * A1[:, b],
+             A0[:, a] * A1[:, b] + A1[:, a] * A0[:, b]]
+        return np.ascontiguousarray(np.concatenate(q)), np.array([a, b], dtype=np.int64)
+    q = [np.einsum("ga,gb->gab", X, Y).reshape(X.shape[0], -1)
+         for X, Y in ((A0, B0), (A0, B1), (A1, B0), (A1, B1))]
+    return np.ascontiguousarray(np.concatenate(q)), None
+
+
+def kernel_operators(op: LayerOperators) -> KernelOperators:
+    """The kernel's arrays for ``op``, cached on the operator."""
+    cached = op.__dict__.get("_kernel_operators")
+    if cached is not None:
+        return cached
+    u = np.asarray(op.u_columns, dtype=bool)
+    ucols, wcols = np.flatnonzero(u), np.flatnonzero(~u)
+    # Rows must vanish off their field's columns for the uu/ww/uw split to be exact.
+    if np.any(op.N_eta[:, wcols]) or np.any(op.N_xi[:, wcols]) or np.any(
+            op.M_eta[:, ucols]) or np.any(op.M_xi[:, ucols]):
+        raise ValueError(f"{op.name}: N rows must vanish on w columns and M rows on u columns")
+    N0, N1 = op.N_eta[:, ucols], op.N_xi[:, ucols]
+    M0, M1 = op.M_eta[:, wcols], op.M_xi[:, wcols]
+    Quu, pu = _packed_products(N0, N1, N0, N1, True)
+    Qww, pw = _packed_products(M0, M1, M0, M1, True)
+    Quw, _ = _packed_products(N0, N1, M0, M1, False)
+    Nu = np.ascontiguousarray(np.concatenate([N0, N1]))
+    Mw = np.ascontiguousarray(np.concatenate([M0, M1]))
+    k = KernelOperators(
+        NuT=np.ascontiguousarray(Nu.T), MwT=np.ascontiguousarray(Mw.T), Nu=Nu, Mw=Mw,
+        Quu=Quu, Qww=Qww, Quw=Quw, pu=pu, pw=pw,
+        ucols=ucols.astype(np.int64), wcols=wcols.astype(np.int64),
+        dofs=np.asarray(op.dofs, dtype=np.int64), x_slope=np.asarray(op.x_slope, dtype=np.bool_),
+        weight=np.ascontiguousarray(op.weight, dtype=float),
+        stiffness=np.ascontiguousarray(op.stiffness, dtype=float), thickness=float(op.thickness),
+    )
+    object.__setattr__(op, "_kernel_operators", k)
+    return k
+
+
+def point_flops(op: LayerOperators, tangent: bool = True) -> int:
+    """Floating-point operations per Gauss point of the kernel's GEMMs (multiply + add = 2).
+
+    Force: the 4 gradients and the force from the 4 row coefficients, 2·2(n_u + n_w) each.
+    Tangent: per point 3 (uu) + 3 (ww) + 4 (uw) rows of Q times their packed pairs. The O(1)
+    per-point work (strains, stresses, H: ~150 flops) and the scatter are left out.
+    """
+    nu = int(np.count_nonzero(op.u_columns))
+    nw = int(op.dofs.size - nu)
+    f = 2 * 2 * 2 * (nu + nw)
+    if not tangent:
+        return f
+    return f + 2 * (3 * nu * (nu + 1) // 2 + 3 * nw * (nw + 1) // 2 + 4 * nu * nw)
+
+
+CHUNK = 128  # elements per block: the block's work arrays stay in cache
+
+
+@njit
+def _kernel(u_e, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols, wcols, dofs,
+            x_slope, weight, C, thickness, f_out, want_k, K_out, slots, signs,
+            data):  # pragma: no cover - compiled
+    """Force into ``f_out`` (E, n); tangent into ``K_out`` (E, n, n) or ``data[slots]``."""
+    E = u_e.shape[0]
+    G = weight.size
+    nu = ucols.size
+    nw = wcols.size
+    n = dofs.size
+    blocks = K_out.shape[0] > 0
+    scatter = slots.shape[0] > 0
+    dz = 2.0 / thickness
+    c00, c01, c02 = C[0, 0], C[0, 1], C[0, 2]
+    c10, c11, c12 = C[1, 0], C[1, 1], C[1, 2]
+    c20, c21, c22 = C[2, 0], C[2, 1], C[2, 2]
+    for e0 in range(0, E, CHUNK):
+        ec = min(CHUNK, E - e0)
+        scale = np.empty((ec, n))
+        Uu = np.empty((ec, nu))
+        Uw = np.empty((ec, nw))
+        for i in range(ec):
+            half = 0.5 * lengths[e0 + i]
+            for a in range(n):  # u_ref = scale ⊙ u_e: l/2 on x-slope DOFs
+                scale[i, a] = half if x_slope[a] else 1.0
+            for a in range(nu):
+                Uu[i, a] = u_e[e0 + i, dofs[ucols[a]]] * scale[i, ucols[a]]
+            for a in range(nw):
+                Uw[i, a] = u_e[e0 + i, dofs[wcols[a]]] * scale[i, wcols[a]]
+        Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
+        Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
+        Cu = np.empty((ec, 2 * G))
+        Cw = np.empty((ec, 2 * G))
+        if want_k:
+            Huu = np.empty((ec, 3 * G))
+            Hww = np.empty((ec, 3 * G))
+            Huw = np.empty((ec, 4 * G))
+        else:
+            Huu = np.empty((0, 0))
+            Hww = np.empty((0, 0))
+            Huw = np.empty((0, 0))
+        for i in range(ec):
+            dx = 2.0 / lengths[e0 + i]
+            dV0 = width * (0.5 * lengths[e0 + i]) * (0.5 * thickness)  # b l h / 4, eq. (19)
+            for g in range(G):
+                ux = dx * Du[i, g]  # eq. (15)
+                uz = dz * Du[i, G + g]
+                wx = dx * Dw[i, g]
+                wz = dz * Dw[i, G + g]
+                ex = ux + 0.5 * (ux * ux + wx * wx)  # Green-Lagrange, eq. (15)
+                ez = wz + 0.5 * (uz * uz + wz * wz)
+                gm = uz + wx + ux * uz + wx * wz
+                dV = dV0 * weight[g]
+                sa = dV * (c00 * ex + c01 * ez + c02 * gm)  # dV σ, eq. (3)
+                sb = dV * (c10 * ex + c11 * ez + c12 * gm)
+                st = dV * (c20 * ex + c21 * ez + c22 * gm)
+                # eq. (19): Σ_g dV σ·B = Σ_g c·R, the rows of eq. (17) sorted by R
+                Cu[i, g] = dx * (sa * (1 + ux) + st * uz)
+                Cu[i, G + g] = dz * (sb * uz + st * (1 + ux))
+                Cw[i, g] = dx * (sa * wx + st * (1 + wz))
+                Cw[i, G + g] = dz * (sb * (1 + wz) + st * wx)
+                if not want_k:
+                    continue
+                # Φ of strain_coefficients (B = Φ R, eq. 17): rows (p00 0 p02 0),
+                # (0 p11 0 p13), (p20 p21 p22 p23)
+                p00 = dx * (1 + ux)
+                p02 = dx * wx
+                p11 = dz * uz
+                p13 = dz * (1 + wz)
+                p20 = dx * uz
+                p21 = dz * (1 + ux)
+                p22 = dx * (1 + wz)
+                p23 = dz * wx
+                a00 = c00 * p00 + c02 * p20  # CΦ
+                a01 = c01 * p11 + c02 * p21
+                a02 = c00 * p02 + c02 * p22
+                a03 = c01 * p13 + c02 * p23
+                a11 = c11 * p11 + c12 * p21
+                a12 = c10 * p02 + c12 * p22
+                a13 = c11 * p13 + c12 * p23
+                a20 = c20 * p00 + c22 * p20
+                a21 = c21 * p11 + c22 * p21
+                a22 = c20 * p02 + c22 * p22
+                a23 = c21 * p13 + c22 * p23
+                sx = sa * dx * dx  # eq. (25): σ_x (N,xᵀN,x + M,xᵀM,x)
+                sz = sb * dz * dz  # σ_z (N,zᵀN,z + M,zᵀM,z)
+                sxz = st * dx * dz  # τ (N,zᵀN,x + N,xᵀN,z + M,zᵀM,x + M,xᵀM,z)
+                # H = dV Φᵀ C Φ (eq. 24) + the stress terms (eq. 25)
+                Huu[i, g] = dV * (p00 * a00 + p20 * a20) + sx  # H00
+                Huu[i, G + g] = dV * (p11 * a11 + p21 * a21) + sz  # H11
+                Huu[i, 2 * G + g] = dV * (p00 * a01 + p20 * a21) + sxz  # H01
+                Hww[i, g] = dV * (p02 * a02 + p22 * a22) + sx  # H22
+                Hww[i, G + g] = dV * (p13 * a13 + p23 * a23) + sz  # H33
+                Hww[i, 2 * G + g] = dV * (p02 * a03 + p22 * a23) + sxz  # H23
+                Huw[i, g] = dV * (p00 * a02 + p20 * a22)  # H02
+                Huw[i, G + g] = dV * (p00 * a03 + p20 * a23)  # H03
+                Huw[i, 2 * G + g] = dV * (p11 * a12 + p21 * a22)  # H12
+                Huw[i, 3 * G + g] = dV * (p11 * a13 + p21 * a23)  # H13
+        Fu = np.dot(Cu, Nu)  # (ec, n_u)
+        Fw = np.dot(Cw, Mw)
+        for i in range(ec):
+            for a in range(nu):
+                f_out[e0 + i, ucols[a]] = Fu[i, a] * scale[i, ucols[a]]
+            for a in range(nw):
+                f_out[e0 + i, wcols[a]] = Fw[i, a] * scale[i, wcols[a]]
+        if not want_k:
+            continue
+        Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
+        Kww = np.dot(Hww, Qww)
+        Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
+        for i in range(ec):
+            e = e0 + i
+            # (column a, column b, value) of every independent entry, physical (scaled)
+            for p in range(pu.shape[1]):
+                ia = ucols[pu[0, p]]
+                ib = ucols[pu[1, p]]
+                v = Kuu[i, p] * scale[i, ia] * scale[i, ib]
+                if blocks:
+                    K_out[e, ia, ib] = v
+                    K_out[e, ib, ia] = v
+                if scatter:
+                    s = slots[e, ia, ib]
+                    if s >= 0:
+                        data[s] += signs[e, ia, ib] * v
+                    if ia != ib:
+                        s = slots[e, ib, ia]
+                        if s >= 0:
+                            data[s] += signs[e, ib, ia] * v
+            for p in range(pw.shape[1]):
+                ia = wcols[pw[0, p]]
+                ib = wcols[pw[1, p]]
+                v = Kww[i, p] * scale[i, ia] * scale[i, ib]
+                if blocks:
+                    K_out[e, ia, ib] = v
+                    K_out[e, ib, ia] = v
+                if scatter:
+                    s = slots[e, ia, ib]
+                    if s >= 0:
+                        data[s] += signs[e, ia, ib] * v
+                    if ia != ib:
+                        s = slots[e, ib, ia]
+                        if s >= 0:
+                            data[s] += signs[e, ib, ia] * v
+            for a in range(nu):
+                ia = ucols[a]
+                for b in range(nw):
+                    ib = wcols[b]
+                    v = Kuw[i, a * nw + b] * scale[i, ia] * scale[i, ib]
+                    if blocks:
+                        K_out[e, ia, ib] = v
+                        K_out[e, ib, ia] = v
+                    if scatter:
+                        s = slots[e, ia, ib]
+                        if s >= 0:
+                            data[s] += signs[e, ia, ib] * v
+                        s = slots[e, ib, ia]
+                        if s >= 0:
+                            data[s] += signs[e, ib, ia] * v
+
+
+@njit
+def scatter_blocks(blocks, slots, signs, data):  # pragma: no cover - compiled
+    """``data[slots] += signs · blocks`` over all entries with a slot (blocks ``(B, n, n)``)."""
+    for e in range(blocks.shape[0]):
+        for a in range(blocks.shape[1]):
+            for b in range(blocks.shape[2]):
+                s = slots[e, a, b]
+                if s >= 0:
+                    data[s] += signs[e, a, b] * blocks[e, a, b]
+
+
+_NO_BLOCKS = np.empty((0, 0, 0))
+_NO_SLOTS = np.empty((0, 0, 0), dtype=np.int32)
+_NO_SIGNS = np.empty((0, 0, 0), dtype=np.int8)
+_NO_DATA = np.empty(0)
+
+
+def _run(op, u_e, lengths, width, want_k, K_out, slots, signs, data):
+    k = kernel_operators(op)
+    u_e = np.ascontiguousarray(u_e, dtype=float)
+    lengths = np.ascontiguousarray(lengths, dtype=float)
+    f = np.empty((u_e.shape[0], k.dofs.size))
+    _kernel(u_e, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww, k.Quw, k.pu,
+            k.pw, k.ucols, k.wcols, k.dofs, k.x_slope, k.weight, k.stiffness, k.thickness, f,
+            want_k, K_out, slots, signs, data)
+    return f
+
+
+def layer_response(
+    op: LayerOperators, u_e: np.ndarray, lengths: np.ndarray, width: float,
+    tangent: bool = True,
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Force ``(E, n)`` and tangent blocks ``(E, n, n)`` (or None).
+
+    The compiled twin of :func:`beam_element.element.layer_response`.
+
+    Parameters
+    ----------
+    op
+        The layer (without ``membrane_average``, see :func:`supports`).
+    u_e
+        Element DOF vectors ``(E, n_element)`` (physical slopes), indexed by ``op.dofs``.
+    lengths
+        Element lengths (mm), ``(E,)``.
+    width
+        Beam width (mm).
+    tangent
+        Whether to compute the tangent.
+    """
+    if not supports(op):
+        raise ValueError("membrane_average layers use beam_element.element")
+    E, n = u_e.shape[0], op.dofs.size
+    K = np.empty((E, n, n)) if tangent else _NO_BLOCKS
+    f = _run(op, u_e, lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS, _NO_DATA)
+    return f, (K if tangent else None)
+
+
+def layer_assemble(
+    op: LayerOperators, u_e: np.ndarray, lengths: np.ndarray, width: float,
+    slots: np.ndarray | None, signs: np.ndarray | None, data: np.ndarray,
+) -> np.ndarray:
+    """Force ``(E, n)``; with ``slots`` the tangent is added into ``data`` (CSR values) in place.
+
+    ``slots[e, a, b]`` is the CSR slot of the layer's entry (a, b) of element e in the reduced
+    matrix (−1 if it is eliminated) and ``signs`` its sign product
+    (:meth:`beam_element.assembly.ReducedPattern.family_slots`).
+    """
+    if slots is None:
+        return _run(op, u_e, lengths, width, False, _NO_BLOCKS, _NO_SLOTS, _NO_SIGNS, _NO_DATA)
+    return _run(op, u_e, lengths, width, True, _NO_BLOCKS, slots, signs, data)

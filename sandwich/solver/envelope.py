@@ -1,0 +1,320 @@
+"""Envelope (variable-band) LDLᵀ of a sparse symmetric tangent, with its inertia.
+
+A 1D model numbered node by node (the beam) has a tangent whose non-zeros hug the diagonal:
+row i couples to columns ``first[i] … i`` only, and the LDLᵀ factor of such a matrix fills in
+nowhere outside that *envelope*. Factorising inside the envelope costs Σᵢ (i − first[i])²/2
+multiply-adds, against n·b²/2 for a fixed band of half-width b (the wider rows of the contact
+pairs do not widen the whole band) and with none of a general sparse LU's symbolic overhead.
+
+The factorisation is the one :class:`sandwich.solver.sparse.SparseFactorization` asks SuperLU
+for — symmetric, without pivoting, so ``K = L D Lᵀ`` and, by Sylvester's law of inertia, the
+number of negative entries of D is the number of negative eigenvalues of K (what the path
+follower needs for bifurcations) — computed in the envelope by a compiled row-by-row Crout
+kernel (:func:`_ldlt`). It is trusted under the same tests as there: every pivot finite and
+above ``singular_rtol · n · max|K|`` and the factors' growth below
+:data:`~sandwich.solver.sparse.GROWTH_LIMIT`. Otherwise :func:`factorize_envelope` falls back
+to :class:`~sandwich.solver.sparse.SparseFactorization` (SuperLU; a pivoting LU with unknown
+inertia when even that fails). LAPACK has no banded LDLᵀ with pivoting for indefinite matrices:
+``dpbtrf`` (banded Cholesky) fails on every state past the first bifurcation and ``dgbtrf``
+(banded LU with row interchanges) gives only the sign of det K, not the count of negative
+eigenvalues (docs/beam_speed.md).
+
+The symbolic work — ordering (natural or reverse Cuthill-McKee, whichever has the smaller
+envelope), ``first``, the row pointers and the map from CSR slots to envelope positions — is an
+:class:`EnvelopeStructure`, computed once per sparsity pattern and reused for every matrix of
+that pattern. A symmetric permutation P K Pᵀ is congruent to K: the inertia does not depend on
+the ordering.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from sandwich.solver.jit import njit
+from sandwich.solver.sparse import GROWTH_LIMIT, SingularTangentError, SparseFactorization
+
+__all__ = ["EnvelopeFactorization", "EnvelopeStructure", "factorize_envelope"]
+
+
+def _envelope_first(indptr: np.ndarray, indices: np.ndarray, order: np.ndarray) -> np.ndarray:
+    """first[i] of the matrix permuted by ``order`` (new → old), from its CSR pattern."""
+    n = indptr.size - 1
+    inv = np.empty(n, dtype=np.int64)
+    inv[order] = np.arange(n)
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    i, j = inv[rows], inv[indices]
+    first = np.arange(n)
+    lower = j < i
+    np.minimum.at(first, i[lower], j[lower])
+    upper = i < j  # the pattern may be stored as the full symmetric matrix or not: use both
+    np.minimum.at(first, j[upper], i[upper])
+    return first
+
+
+@dataclass(frozen=True)
+class EnvelopeStructure:
+    """Symbolic part of an envelope LDLᵀ for one sparsity pattern (computed once)."""
+
+    n: int
+    order: np.ndarray  # (n,) new → old
+    first: np.ndarray  # (n,) first column of row i (new numbering) in the envelope
+    rowptr: np.ndarray  # (n + 1,) row i is env[rowptr[i]: rowptr[i + 1]], columns first[i]..i
+    slots: np.ndarray  # CSR slots of the lower-triangle (new numbering) entries …
+    positions: np.ndarray  # … and their positions in env
+    indptr: np.ndarray  # the pattern it was built for
+    indices: np.ndarray
+    ordering: str  # "natural" or "rcm"
+
+    @property
+    def size(self) -> int:
+        """Number of stored envelope entries (diagonal included)."""
+        return int(self.rowptr[-1])
+
+    @property
+    def flops(self) -> float:
+        """Floating-point operations of one factorisation (multiply + add = 2), exactly."""
+        return float(_count_flops(self.first, self.n))
+
+    @property
+    def half_bandwidth(self) -> int:
+        """Largest i − first[i]."""
+        return int(np.max(np.arange(self.n) - self.first)) if self.n else 0
+
+    def matches(self, K: sp.csr_matrix) -> bool:
+        """Whether ``K`` (CSR) has the pattern this structure was built for."""
+        return (K.shape == (self.n, self.n) and K.indptr.size == self.indptr.size
+                and K.indices.size == self.indices.size
+                and (K.indices is self.indices or np.array_equal(K.indices, self.indices))
+                and (K.indptr is self.indptr or np.array_equal(K.indptr, self.indptr)))
+
+    @classmethod
+    def of(cls, K: sp.spmatrix) -> EnvelopeStructure:
+        """Structure for the pattern of ``K`` (CSR, canonical: sorted, no duplicates)."""
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+        K = _canonical_csr(K)
+        n = K.shape[0]
+        indptr, indices = K.indptr, K.indices
+        candidates = {"natural": np.arange(n)}
+        if n > 1:
+            candidates["rcm"] = np.asarray(
+                reverse_cuthill_mckee(sp.csr_matrix((np.ones(indices.size), indices, indptr),
+                                                    shape=K.shape), symmetric_mode=True),
+                dtype=np.int64)
+        best = None
+        for name, order in candidates.items():
+            first = _envelope_first(indptr, indices, order)
+            p = np.arange(n) - first
+            cost = float(np.sum(p * p))
+            if best is None or cost < 0.9 * best[0]:  # natural unless RCM is clearly better
+                best = (cost, name, order, first)
+        _, name, order, first = best
+        rowptr = np.zeros(n + 1, dtype=np.int64)
+        rowptr[1:] = np.cumsum(np.arange(n) - first + 1)
+        inv = np.empty(n, dtype=np.int64)
+        inv[order] = np.arange(n)
+        rows = np.repeat(np.arange(n), np.diff(indptr))
+        i, j = inv[rows], inv[indices]
+        lower = np.flatnonzero(j <= i)
+        positions = rowptr[i[lower]] + (j[lower] - first[i[lower]])
+        return cls(n=n, order=order, first=first.astype(np.int64), rowptr=rowptr,
+                   slots=lower.astype(np.int64), positions=positions.astype(np.int64),
+                   indptr=indptr, indices=indices, ordering=name)
+
+
+def _canonical_csr(K: object) -> sp.csr_matrix:
+    A = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
+    if A.shape[0] != A.shape[1]:
+        raise ValueError(f"tangent must be square, got shape {A.shape}")
+    if not A.has_canonical_format:
+        A = A.copy()
+        A.sum_duplicates()
+    return A
+
+
+@njit
+def _count_flops(first, n):  # pragma: no cover - compiled
+    """Operations of :func:`_ldlt`: 2 per inner multiply-add, 3 per off-diagonal (L, d)."""
+    total = 0
+    for i in range(n):
+        fi = first[i]
+        for j in range(fi, i):
+            k0 = fi if fi > first[j] else first[j]
+            total += 2 * (j - k0) + 3
+    return total
+
+
+@njit
+def _load(data, slots, positions, size):  # pragma: no cover - compiled
+    """Envelope of the lower triangle from CSR values, and max |K| (NaN if one is not finite)."""
+    env = np.zeros(size)
+    for t in range(slots.size):
+        env[positions[t]] = data[slots[t]]
+    kmax = 0.0
+    for t in range(data.size):
+        a = abs(data[t])
+        if not (a <= 1.0e308):
+            return env, np.nan
+        if a > kmax:
+            kmax = a
+    return env, kmax
+
+
+@njit(reassociate=True)
+def _ldlt(env, rowptr, first, n, w):  # pragma: no cover - compiled
+    """In-place envelope LDLᵀ (row-by-row Crout): L below the diagonal, D on it.
+
+    Row i: w_j = a_ij − Σ_k w_k L_jk (k from max(first_i, first_j) to j − 1) is (L D)_ij, then
+    L_ij = w_j / d_j and d_i = a_ii − Σ_j w_j L_ij. Returns (negative pivots, min |d|,
+    max |L D|, max |L|).
+    """
+    negative = 0
+    finite = True
+    dmin = np.inf
+    ldmax = 0.0
+    lmax = 0.0
+    for i in range(n):
+        fi = first[i]
+        ri = rowptr[i] - fi  # env[ri + j] is entry (i, j)
+        for j in range(fi, i):
+            fj = first[j]
+            rj = rowptr[j] - fj
+            k0 = fi if fi > fj else fj
+            s = env[ri + j]
+            for k in range(k0, j):
+                s -= w[k] * env[rj + k]
+            w[j] = s
+        d = env[ri + i]
+        for j in range(fi, i):
+            lij = w[j] / env[rowptr[j + 1] - 1]
+            d -= w[j] * lij
+            env[ri + j] = lij
+            aw = abs(w[j])
+            if aw > ldmax:
+                ldmax = aw
+            al = abs(lij)
+            if al > lmax:
+                lmax = al
+        env[ri + i] = d
+        ad = abs(d)
+        if not (ad <= 1.0e308):  # inf or NaN
+            finite = False
+        if ad < dmin:
+            dmin = ad
+        if ad > ldmax:
+            ldmax = ad
+        if d < 0.0:
+            negative += 1
+    if not finite:
+        dmin = np.nan
+    return negative, dmin, ldmax, lmax
+
+
+@njit(reassociate=True)
+def _solve(env, rowptr, first, n, order, b, x):  # pragma: no cover - compiled
+    """Solve K x = b with K = Pᵀ L D Lᵀ P; b, x of shape (n, m), m right-hand sides."""
+    y = np.empty(n)
+    for c in range(b.shape[1]):
+        for i in range(n):  # forward: L y = P b
+            fi = first[i]
+            ri = rowptr[i] - fi
+            s = b[order[i], c]
+            for k in range(fi, i):
+                s -= env[ri + k] * y[k]
+            y[i] = s
+        for i in range(n):  # D z = y
+            y[i] /= env[rowptr[i + 1] - 1]
+        for i in range(n - 1, -1, -1):  # backward: Lᵀ x = z, column by column
+            fi = first[i]
+            ri = rowptr[i] - fi
+            xi = y[i]
+            for k in range(fi, i):
+                y[k] -= env[ri + k] * xi
+        for i in range(n):
+            x[order[i], c] = y[i]
+
+
+class EnvelopeFactorization:
+    """Envelope LDLᵀ of a symmetric matrix whose pivot-free factorisation is trustworthy.
+
+    Build with :func:`factorize_envelope` (which falls back to SuperLU when it is not).
+
+    Attributes
+    ----------
+    structure : EnvelopeStructure
+        The symbolic part used.
+    """
+
+    pivoted = False
+
+    def __init__(self, env: np.ndarray, structure: EnvelopeStructure, negative: int) -> None:
+        self._env = env
+        self.structure = structure
+        self.size = structure.n
+        self._negative = negative
+
+    @property
+    def negative_pivots(self) -> int:
+        """Number of negative eigenvalues of ``K`` (Sylvester)."""
+        return self._negative
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Return ``K⁻¹ b`` for a vector (or a matrix of right-hand sides, one per column)."""
+        b = np.asarray(b, dtype=float)
+        s = self.structure
+        if b.shape[:1] != (s.n,) or b.ndim > 2:
+            raise ValueError(f"expected {s.n} rows, got shape {b.shape}")
+        B = b.reshape(s.n, -1)
+        x = np.empty(B.shape)
+        _solve(self._env, s.rowptr, s.first, s.n, s.order, B, x)
+        return x.reshape(b.shape)
+
+
+def factorize_envelope(
+    K: object,
+    structure: EnvelopeStructure | None = None,
+    singular_rtol: float = float(np.finfo(float).eps),
+) -> EnvelopeFactorization | SparseFactorization:
+    """Factorise the symmetric ``K`` in its envelope, or fall back to SuperLU.
+
+    Parameters
+    ----------
+    K
+        Symmetric matrix (CSR preferred; only its lower triangle is read).
+    structure
+        Symbolic part for K's pattern (computed if omitted or if it does not match).
+    singular_rtol
+        As in :class:`~sandwich.solver.sparse.SparseFactorization`.
+
+    Returns
+    -------
+    EnvelopeFactorization or SparseFactorization
+        The latter (SuperLU) when the pivot-free LDLᵀ has a tiny pivot or too much growth.
+
+    Raises
+    ------
+    SingularTangentError
+        Non-finite entries, the zero matrix, or (from the fallback) a singular matrix.
+    """
+    A = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
+    if structure is None or not structure.matches(A):  # a match has canonical indices
+        A = _canonical_csr(A)
+        structure = EnvelopeStructure.of(A)
+    n = A.shape[0]
+    if n == 0:
+        return SparseFactorization(A)
+    env, kmax = _load(A.data, structure.slots, structure.positions, structure.size)
+    if not np.isfinite(kmax):
+        raise SingularTangentError("tangent has non-finite entries")
+    if kmax == 0.0:
+        raise SingularTangentError("tangent is the zero matrix")
+    negative, dmin, ldmax, lmax = _ldlt(env, structure.rowptr, structure.first, n,
+                                        np.empty(n))
+    growth = max(ldmax / kmax, lmax)
+    if (not np.isfinite(dmin) or dmin <= singular_rtol * n * kmax
+            or not np.isfinite(growth) or growth > GROWTH_LIMIT):
+        return SparseFactorization(A, singular_rtol)
+    return EnvelopeFactorization(env, structure, int(negative))
