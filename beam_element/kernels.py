@@ -137,15 +137,18 @@ CHUNK = 128  # elements per block: the block's work arrays stay in cache
 
 
 @njit
-def _kernel(u_e, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols, wcols, dofs,
+def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols, wcols,
             x_slope, weight, C, thickness, f_out, want_k, K_out, slots, signs,
             data):  # pragma: no cover - compiled
-    """Force into ``f_out`` (E, n); tangent into ``K_out`` (E, n, n) or ``data[slots]``."""
-    E = u_e.shape[0]
+    """Force into ``f_out`` (E, n); tangent into ``K_out`` (E, n, n) or ``data[slots]``.
+
+    ``u_l`` (E, n) holds each element's values of the layer's DOFs (physical slopes).
+    """
+    E = u_l.shape[0]
     G = weight.size
     nu = ucols.size
     nw = wcols.size
-    n = dofs.size
+    n = x_slope.size
     blocks = K_out.shape[0] > 0
     scatter = slots.shape[0] > 0
     dz = 2.0 / thickness
@@ -162,9 +165,9 @@ def _kernel(u_e, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
             for a in range(n):  # u_ref = scale ⊙ u_e: l/2 on x-slope DOFs
                 scale[i, a] = half if x_slope[a] else 1.0
             for a in range(nu):
-                Uu[i, a] = u_e[e0 + i, dofs[ucols[a]]] * scale[i, ucols[a]]
+                Uu[i, a] = u_l[e0 + i, ucols[a]] * scale[i, ucols[a]]
             for a in range(nw):
-                Uw[i, a] = u_e[e0 + i, dofs[wcols[a]]] * scale[i, wcols[a]]
+                Uw[i, a] = u_l[e0 + i, wcols[a]] * scale[i, wcols[a]]
         Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
         Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
         Cu = np.empty((ec, 2 * G))
@@ -313,13 +316,17 @@ _NO_SIGNS = np.empty((0, 0, 0), dtype=np.int8)
 _NO_DATA = np.empty(0)
 
 
-def _run(op, u_e, lengths, width, want_k, K_out, slots, signs, data):
+def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
     k = kernel_operators(op)
-    u_e = np.ascontiguousarray(u_e, dtype=float)
+    u_l = np.ascontiguousarray(u_l, dtype=float)
+    if u_l.ndim != 2 or u_l.shape[1] != k.dofs.size:
+        raise ValueError(f"expected values of the layer's {k.dofs.size} DOFs, got {u_l.shape}")
     lengths = np.ascontiguousarray(lengths, dtype=float)
-    f = np.empty((u_e.shape[0], k.dofs.size))
-    _kernel(u_e, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww, k.Quw, k.pu,
-            k.pw, k.ucols, k.wcols, k.dofs, k.x_slope, k.weight, k.stiffness, k.thickness, f,
+    if lengths.shape != (u_l.shape[0],):
+        raise ValueError(f"expected {u_l.shape[0]} element lengths, got {lengths.shape}")
+    f = np.empty((u_l.shape[0], k.dofs.size))
+    _kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww, k.Quw, k.pu,
+            k.pw, k.ucols, k.wcols, k.x_slope, k.weight, k.stiffness, k.thickness, f,
             want_k, K_out, slots, signs, data)
     return f
 
@@ -349,20 +356,24 @@ def layer_response(
         raise ValueError("membrane_average layers use beam_element.element")
     E, n = u_e.shape[0], op.dofs.size
     K = np.empty((E, n, n)) if tangent else _NO_BLOCKS
-    f = _run(op, u_e, lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS, _NO_DATA)
+    f = _run(op, np.asarray(u_e)[:, op.dofs], lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS,
+             _NO_DATA)
     return f, (K if tangent else None)
 
 
 def layer_assemble(
-    op: LayerOperators, u_e: np.ndarray, lengths: np.ndarray, width: float,
+    op: LayerOperators, u_l: np.ndarray, lengths: np.ndarray, width: float,
     slots: np.ndarray | None, signs: np.ndarray | None, data: np.ndarray,
 ) -> np.ndarray:
     """Force ``(E, n)``; with ``slots`` the tangent is added into ``data`` (CSR values) in place.
+
+    ``u_l`` ``(E, n)`` holds the values of the layer's DOFs ``op.dofs`` of each element (physical
+    slopes), e.g. ``u_full[family DOFs]``.
 
     ``slots[e, a, b]`` is the CSR slot of the layer's entry (a, b) of element e in the reduced
     matrix (−1 if it is eliminated) and ``signs`` its sign product
     (:meth:`beam_element.assembly.ReducedPattern.family_slots`).
     """
     if slots is None:
-        return _run(op, u_e, lengths, width, False, _NO_BLOCKS, _NO_SLOTS, _NO_SIGNS, _NO_DATA)
-    return _run(op, u_e, lengths, width, True, _NO_BLOCKS, slots, signs, data)
+        return _run(op, u_l, lengths, width, False, _NO_BLOCKS, _NO_SLOTS, _NO_SIGNS, _NO_DATA)
+    return _run(op, u_l, lengths, width, True, _NO_BLOCKS, slots, signs, data)
