@@ -86,4 +86,6 @@ def njit(fn: Callable | None = None, *, reassociate: bool = False) -> Callable:
     import numba
 
     flags = {"reassoc", "contract"} if reassociate else False
-    return numba.njit(cache=True, nogil=True, fastmath=flags)(fn)
+    # error_model "numpy": a division by zero gives inf/NaN (checked by the callers), not an
+    # exception from inside the loop
+    return numba.njit(cache=True, nogil=True, fastmath=flags, error_model="numpy")(fn)

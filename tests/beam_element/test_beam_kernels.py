@@ -1,0 +1,188 @@
+"""Compiled layer kernels (beam_element.kernels) against the NumPy reference (beam_element.element).
+
+References: the NumPy path of beam_element.element (force of eq. 19, tangent of eqs. 24-25), kept
+as the reference implementation, to round-off; central finite differences of the kernel's own
+force for its tangent; and the model's NumPy path (use_kernels = False) for the assembled force
+and reduced tangent, with debonds, contact and core levels > 1. Genericity in the layer's DOF
+count n and point count G: a synthetic layer with extra DOFs and a non-tensor rule.
+"""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from beam_scenes import KEVLAR, ROHACELL, Debond, sandwich_scene  # noqa: I001
+
+from beam_element import element, kernels
+from beam_element.constitutive import core_stiffness, face_stiffness
+from beam_element.layer_operators import build_layer_operators
+from beam_element.model import build_model
+from beam_element.quadrature import EXACT_ORDER
+from sandwich.solver.envelope import EnvelopeFactorization
+from sandwich.solver.sparse import SparseFactorization
+
+LAYERS = [("top", 0.5, face_stiffness(KEVLAR)), ("core", 25.0, core_stiffness(ROHACELL)),
+          ("bottom", 0.5, face_stiffness(KEVLAR))]
+
+
+def _rel(a, b):
+    return np.max(np.abs(a - b)) / np.max(np.abs(b))
+
+
+@pytest.mark.parametrize("name,h,C", LAYERS)
+@pytest.mark.parametrize("gauss", ["exact", (3, 2), (9, 8)])
+def test_kernel_matches_numpy_reference(name, h, C, gauss):
+    rng = np.random.default_rng(11)
+    op = build_layer_operators(name, h, 0.0, C, gauss=EXACT_ORDER[name] if gauss == "exact"
+                               else gauss)
+    E = 300  # more than one kernel block (CHUNK = 128), last one partial
+    u = rng.normal(size=(E, 40)) * 0.5
+    lengths = rng.uniform(1.0, 9.0, size=E)
+    f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
+    f, K = kernels.layer_response(op, u, lengths, 60.0)
+    assert _rel(f, f_ref) < 1e-13
+    assert _rel(K, K_ref) < 1e-13
+    assert np.array_equal(K, K.transpose(0, 2, 1))  # symmetric by construction
+    f_only, none = kernels.layer_response(op, u, lengths, 60.0, tangent=False)
+    assert none is None and np.array_equal(f_only, f)
+
+
+def _enlarged(op, rng, extra=7, points=61):
+    """The layer with ``extra`` more DOFs (random polynomial-like rows) and a random rule.
+
+    Stands for the core hierarchy's extended layers: more DOFs per element, composite rules.
+    """
+    G = points
+    eta, xi = rng.uniform(-1, 1, size=G), rng.uniform(-1, 1, size=G)
+    base = op.at(eta, xi)
+    n0 = op.dofs.size
+    is_u = rng.random(extra) < 0.5
+
+    def cols(kind):
+        new = rng.normal(size=(G, extra)) * (1 + eta[:, None] ** 2) * (1 - 0.3 * xi[:, None])
+        mask = is_u if kind == "N" else ~is_u
+        return new * mask[None, :]
+
+    rows = {key: np.concatenate([getattr(base, key), cols(key[0])], axis=1)
+            for key in ("N", "M", "N_eta", "N_xi", "M_eta", "M_xi")}
+    big = replace(base, dofs=np.concatenate([op.dofs, 40 + np.arange(extra)]),
+                  weight=rng.uniform(0.01, 0.1, size=G),
+                  x_slope=np.concatenate([op.x_slope, rng.random(extra) < 0.5]),
+                  u_mask=np.concatenate([op.u_columns, is_u]), **rows)
+    assert big.dofs.size == n0 + extra
+    return big
+
+
+@pytest.mark.parametrize("name,h,C", LAYERS)
+def test_kernel_is_generic_in_dof_and_point_count(name, h, C):
+    rng = np.random.default_rng(5)
+    op = _enlarged(build_layer_operators(name, h, 0.0, C, gauss=EXACT_ORDER[name]), rng)
+    E = 20
+    u = rng.normal(size=(E, 40 + 7)) * 0.3
+    lengths = rng.uniform(1.0, 9.0, size=E)
+    f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
+    f, K = kernels.layer_response(op, u, lengths, 60.0)
+    assert _rel(f, f_ref) < 1e-13
+    assert _rel(K, K_ref) < 1e-13
+
+
+@pytest.mark.parametrize("name,h,C", LAYERS)
+def test_kernel_tangent_matches_finite_differences(name, h, C):
+    rng = np.random.default_rng(2)
+    op = build_layer_operators(name, h, 0.0, C, gauss=EXACT_ORDER[name])
+    lengths = np.array([4.0, 9.0, 2.5])
+    u = rng.normal(size=(3, 40)) * 0.5  # gradients of order 0.1 - 0.3
+    _, K = kernels.layer_response(op, u, lengths, 60.0)
+    step = 1e-6
+    for a, d in enumerate(op.dofs):
+        du = np.zeros_like(u)
+        du[:, d] = step
+        fp = kernels.layer_response(op, u + du, lengths, 60.0, tangent=False)[0]
+        fm = kernels.layer_response(op, u - du, lengths, 60.0, tangent=False)[0]
+        fd = (fp - fm) / (2 * step)
+        assert np.max(np.abs(K[:, :, a] - fd)) < 1e-6 * np.max(np.abs(K))
+
+
+def _contact_state(model, rng):
+    """Random state with a bending wave and every contact pair penetrating (as in
+    test_beam_tangent)."""
+    u = rng.normal(size=model.size) * 0.02
+    free = model.dof_map.free
+    for pairs in model.pairs:
+        sign = 1.0 if pairs.interface == "top" else -1.0
+        w_face, w_core = free[pairs.dofs[:, 1]], free[pairs.dofs[:, 3]]
+        u[w_face] = u[w_core] - sign * rng.uniform(0.02, 0.05, size=w_face.size)
+    return u
+
+
+@pytest.mark.parametrize("options", [
+    {}, {"core_level": 3}, {"core_level": 2, "core_basis": "polynomial"},
+    {"face_membrane": "averaged"}, {"contact_search": "closest-point"},
+])
+def test_model_compiled_path_matches_numpy_path(options):
+    scene = sandwich_scene(length=60.0, elements=16,
+                           debonds=(Debond("top", 15.0, 45.0), Debond("bottom", 0.0, 20.0)))
+    model = build_model(scene, **options)
+    u = _contact_state(model, np.random.default_rng(3))
+    assert model.contact_summary(u)["top"].active > 0
+    model.use_kernels = False
+    f0, K0 = model.internal_force(u), model.tangent(u)
+    model.use_kernels = True
+    model._cache = None
+    f1, K1 = model.internal_force(u), model.tangent(u)
+    assert np.linalg.norm(f1 - f0) <= 1e-13 * np.linalg.norm(f0)
+    assert abs(K1 - K0).max() <= 1e-13 * abs(K0).max()
+    assert K1.nnz == K0.nnz
+
+
+def test_compiled_force_carries_its_tangent():
+    """One pass: the tangent at the last force's u is not evaluated again."""
+    model = build_model(sandwich_scene(length=60.0, elements=8))
+    u = np.random.default_rng(0).normal(size=model.size) * 1e-3
+    model.internal_force(u)
+    K = model._cache[2]
+    assert K is not None and model.tangent(u) is K
+    assert model.residual_roundoff(u) > 0 and model.tangent(u) is K
+
+
+def test_beam_tangent_inertia_matches_superlu_along_a_shift():
+    """On a beam tangent with a bifurcation-like shift, both backends count the same."""
+    scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
+    model = build_model(scene)
+    K = model.tangent(np.zeros(model.size))
+    d = K.diagonal()
+    negative = []
+    for shift in (0.0, 1e-3, 3e-3):
+        A = (K - shift * sp.diags(d)).tocsr()
+        A.sort_indices()
+        env = model.factorize(A)
+        ref = SparseFactorization(A)
+        assert isinstance(env, EnvelopeFactorization)
+        assert env.negative_pivots == ref.negative_pivots
+        negative.append(env.negative_pivots)
+        b = np.arange(model.size, dtype=float)
+        assert np.allclose(env.solve(b), ref.solve(b), rtol=1e-8, atol=1e-10 * np.abs(
+            ref.solve(b)).max())
+    assert negative[0] == 0 and negative[-1] > 0
+
+
+def test_beam_path_imports_no_2d_or_plotting_stack():
+    """Solving a beam scene loads neither dolfinx, gmsh, pyvista nor matplotlib."""
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from beam_scenes import sandwich_scene\n"
+            "from beam_element import build_model\n"
+            "from sandwich.solver import solve_equilibrium\n"
+            "m = build_model(sandwich_scene(length=60.0, elements=8))\n"
+            "r = solve_equilibrium(m, 1.0)\n"
+            "assert r.converged, r.reason\n"
+            "print(sorted(k for k in ('dolfinx', 'gmsh', 'pyvista', 'matplotlib', 'petsc4py')"
+            " if k in sys.modules))\n")
+    here = __import__("pathlib").Path(__file__).resolve().parent
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300, cwd=here)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"

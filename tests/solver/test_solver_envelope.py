@@ -1,0 +1,144 @@
+"""Envelope LDLᵀ (sandwich.solver.envelope): inertia against numpy.linalg.eigvalsh, solves against
+dense solves, the SuperLU fallback, the reuse of the symbolic part, and the numba cache rules."""
+
+import os
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from sandwich.solver import SingularTangentError, SparseFactorization, jit
+from sandwich.solver.envelope import (
+    EnvelopeFactorization,
+    EnvelopeStructure,
+    factorize_envelope,
+)
+
+
+def _variable_band(rng, n, widths):
+    """Random symmetric matrix with row i coupled to up to widths[i] earlier columns,
+    indefinite (diagonal of both signs)."""
+    rows, cols = [], []
+    for i in range(n):
+        for j in range(max(0, i - widths[i]), i):
+            if rng.random() < 0.7:
+                rows.append(i)
+                cols.append(j)
+    L = sp.csr_matrix((rng.normal(size=len(rows)), (rows, cols)), shape=(n, n))
+    return (L + L.T + sp.diags(rng.normal(scale=3.0, size=n))).tocsr()
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_inertia_and_solve_on_random_indefinite_envelopes(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(8, 80))
+    widths = rng.integers(0, 6, size=n)
+    widths[rng.integers(0, n, size=3)] = rng.integers(10, 30, size=3)  # a few wide rows
+    A = _variable_band(rng, n, widths)
+    A.sort_indices()
+    eig = np.linalg.eigvalsh(A.toarray())
+    fac = factorize_envelope(A)
+    assert isinstance(fac, EnvelopeFactorization)
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+    b = rng.normal(size=(n, 2))
+    x = fac.solve(b)
+    cond = np.abs(eig).max() / np.abs(eig).min()
+    assert np.linalg.norm(A @ x - b) <= 1e-12 * cond * np.linalg.norm(b)
+    assert np.allclose(fac.solve(b[:, 0]), x[:, 0], rtol=0, atol=1e-14 * np.abs(x).max())
+
+
+def test_rcm_ordering_recovers_a_scrambled_band():
+    rng = np.random.default_rng(1)
+    n = 200
+    A = _variable_band(rng, n, np.full(n, 3))
+    p = rng.permutation(n)
+    B = A[p][:, p].tocsr()
+    B.sort_indices()
+    s = EnvelopeStructure.of(B)
+    assert s.ordering == "rcm" and s.half_bandwidth <= 12
+    eig = np.linalg.eigvalsh(B.toarray())
+    assert factorize_envelope(B, s).negative_pivots == int(np.count_nonzero(eig < 0))
+
+
+def test_structure_is_reused_only_for_its_pattern():
+    rng = np.random.default_rng(2)
+    A = _variable_band(rng, 30, np.full(30, 2))
+    A.sort_indices()
+    s = EnvelopeStructure.of(A)
+    B = A.copy()
+    B.data = rng.normal(size=B.nnz)
+    B = (B + B.T).tocsr()
+    B.sort_indices()
+    assert s.matches(A)
+    assert s.matches(B) == (B.nnz == A.nnz and np.array_equal(B.indices, A.indices))
+    C = (A + sp.eye(30, k=7) + sp.eye(30, k=-7)).tocsr()
+    assert not s.matches(C)
+    eig = np.linalg.eigvalsh(C.toarray())
+    assert factorize_envelope(C, s).negative_pivots == int(np.count_nonzero(eig < 0))
+
+
+def test_zero_pivot_falls_back_to_superlu():
+    A = sp.csr_matrix(np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 2.0]]))
+    fac = factorize_envelope(A)
+    assert isinstance(fac, SparseFactorization)  # the stated fallback
+    assert np.allclose(A @ fac.solve(np.array([1.0, 2.0, 3.0])), [1.0, 2.0, 3.0])
+
+
+def test_bad_matrices_are_refused():
+    with pytest.raises(SingularTangentError):
+        factorize_envelope(sp.csr_matrix(np.array([[1.0, np.nan], [np.nan, 1.0]])))
+    with pytest.raises(SingularTangentError):
+        factorize_envelope(sp.csr_matrix((3, 3)))
+    with pytest.raises(SingularTangentError):  # singular: the fallback decides
+        factorize_envelope(sp.csr_matrix(np.ones((3, 3))))
+
+
+def test_cache_directory_rules(tmp_path, monkeypatch):
+    """Read-only install: numba's in-tree cache, else the user cache, else a temporary dir."""
+    read_only = {tmp_path / "ro", tmp_path / "home"}
+    real = jit._writable
+
+    def writable(path):
+        return not any(p == path or p in path.parents for p in read_only) and real(path)
+
+    monkeypatch.setattr(jit, "_writable", writable)
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    assert jit.cache_directory((tmp_path / "src",)) == ("in-tree", None)
+    assert jit.cache_directory((tmp_path / "ro",)) == ("user", tmp_path / "cache" / "numba")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "home" / ".cache"))
+    rule, where = jit.cache_directory((tmp_path / "ro",))
+    assert rule == "temporary" and real(where)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "mine"))
+    assert jit.cache_directory((tmp_path / "ro",)) == ("NUMBA_CACHE_DIR", tmp_path / "mine")
+
+
+def test_kernels_run_from_a_read_only_install(tmp_path):
+    """A copy of the package in a read-only location, with a read-only home, still runs."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    site = tmp_path / "site"
+    for pkg in ("sandwich", "beam_element"):
+        shutil.copytree(root / pkg, site / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    code = ("import os, numpy as np, scipy.sparse as sp\n"
+            "from sandwich.solver import jit\n"
+            "print(jit.cache_directory()[0])\n"
+            "from sandwich.solver import envelope\n"
+            "f = envelope.factorize_envelope(sp.csr_matrix(np.diag([1.0, -2.0, 3.0])))\n"
+            "print(f.negative_pivots, bool(os.listdir(os.environ['NUMBA_CACHE_DIR'])))\n")
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(PYTHONPATH=str(site), HOME=str(tmp_path / "nohome"),
+               XDG_CACHE_HOME=str(tmp_path / "nohome" / ".cache"), PYTHONDONTWRITEBYTECODE="1")
+    # read-only: without root, chmod; with root (mode bits ignored), a file where the cache dirs
+    # would go blocks them just as well
+    for d in (site / "sandwich" / "solver", site / "beam_element"):
+        (d / "__pycache__").write_text("not a directory")
+    (tmp_path / "nohome").write_text("not a directory")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=300, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["temporary", "1", "True"]
