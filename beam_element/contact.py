@@ -300,7 +300,7 @@ def pair_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
     a, c = 1.0 + v[:, 4], v[:, 5]  # slave tangent (1 + u_c,x, w_c,x)
     gap, dg, d2g = _gap_derivatives(Δu, Δw, a, c, NORMAL_SIGN[pairs.interface])
     sliding = (a * Δu + c * Δw) / np.sqrt(a**2 + c**2)
-    return PairKinematics(gap, dg @ _D, np.einsum("ia,mij,jb->mab", _D, d2g, _D), sliding)
+    return PairKinematics(gap, dg @ _D, _D.T @ d2g @ _D, sliding)  # Dᵀ (d²g) D per pair
 
 
 def hermite_basis(xi: np.ndarray, length: np.ndarray, orders: int = 4) -> np.ndarray:

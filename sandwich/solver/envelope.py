@@ -29,6 +29,7 @@ the ordering.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -67,18 +68,30 @@ class EnvelopeStructure:
     indptr: np.ndarray  # the pattern it was built for
     indices: np.ndarray
     ordering: str  # "natural" or "rcm"
+    storage: str = "envelope"  # or "band": fixed half-band b, columns stored contiguously
 
     @property
     def size(self) -> int:
-        """Number of stored envelope entries (diagonal included)."""
+        """Number of stored entries (diagonal included)."""
+        if self.storage == "band":
+            return self.n * (self.half_bandwidth + 1)
         return int(self.rowptr[-1])
 
     @property
     def flops(self) -> float:
         """Floating-point operations of one factorisation (multiply + add = 2), exactly."""
+        if self.storage == "band":
+            return _band_flops(self.n, self.half_bandwidth)
         return float(_count_flops(self.first, self.n))
 
     @property
+    def solve_flops(self) -> float:
+        """Floating-point operations of one solve with one right-hand side."""
+        off = self.size - self.n if self.storage == "envelope" else _band_entries(
+            self.n, self.half_bandwidth)
+        return float(4 * off + self.n)
+
+    @cached_property
     def half_bandwidth(self) -> int:
         """Largest i − first[i]."""
         return int(np.max(np.arange(self.n) - self.first)) if self.n else 0
@@ -119,10 +132,38 @@ class EnvelopeStructure:
         rows = np.repeat(np.arange(n), np.diff(indptr))
         i, j = inv[rows], inv[indices]
         lower = np.flatnonzero(j <= i)
-        positions = rowptr[i[lower]] + (j[lower] - first[i[lower]])
+        b = int(np.max(np.arange(n) - first)) if n else 0
+        # A fixed band does the zeros inside it too, but as contiguous AXPYs that vectorise
+        # (measured ≈ 3× the rate of the envelope's short dot products): take it while it costs
+        # less than BAND_ADVANTAGE × the envelope's operations.
+        band = _band_flops(n, b) <= BAND_ADVANTAGE * float(_count_flops(first, n))
+        if band:  # ab[j, k] = K[j + k, j]
+            positions = j[lower] * (b + 1) + (i[lower] - j[lower])
+        else:
+            positions = rowptr[i[lower]] + (j[lower] - first[i[lower]])
         return cls(n=n, order=order, first=first.astype(np.int64), rowptr=rowptr,
                    slots=lower.astype(np.int64), positions=positions.astype(np.int64),
-                   indptr=indptr, indices=indices, ordering=name)
+                   indptr=indptr, indices=indices, ordering=name,
+                   storage="band" if band else "envelope")
+
+
+#: A fixed band is used when its operation count is at most this multiple of the envelope's.
+BAND_ADVANTAGE = 2.5
+
+
+def _band_entries(n: int, b: int) -> int:
+    """Off-diagonal entries of an n×n band of half-width b (lower triangle)."""
+    return n * b - b * (b + 1) // 2 if n > b else n * (n - 1) // 2
+
+
+def _band_flops(n: int, b: int) -> float:
+    """Operations of :func:`_band_ldlt`.
+
+    Per column j with m = min(b, n − 1 − j) entries below the diagonal: m divisions, m products
+    and m(m + 1)/2 multiply-adds.
+    """
+    m = np.minimum(b, n - 1 - np.arange(n)).astype(float)
+    return float(np.sum(2 * m + m * (m + 1)))
 
 
 def _canonical_csr(K: object) -> sp.csr_matrix:
@@ -213,6 +254,73 @@ def _ldlt(env, rowptr, first, n, w):  # pragma: no cover - compiled
     return negative, dmin, ldmax, lmax
 
 
+@njit
+def _band_ldlt(ab, n, b):  # pragma: no cover - compiled
+    """In-place LDLᵀ of a band stored by columns, ab[j, k] = K[j + k, j] (right-looking).
+
+    Column j: d_j = ab[j, 0], l_kj = ab[j, k] / d_j, then every later column j + k loses
+    l_kj d_j l_(k..b)j: contiguous AXPYs. Same returns as :func:`_ldlt`.
+    """
+    negative = 0
+    finite = True
+    dmin = np.inf
+    ldmax = 0.0
+    lmax = 0.0
+    for j in range(n):
+        d = ab[j, 0]
+        ad = abs(d)
+        if not (ad <= 1.0e308):
+            finite = False
+        if ad < dmin:
+            dmin = ad
+        if ad > ldmax:
+            ldmax = ad
+        if d < 0.0:
+            negative += 1
+        m = min(b, n - 1 - j)
+        col = ab[j]
+        for k in range(1, m + 1):
+            a = abs(col[k])  # (L D)_(j+k) j
+            if a > ldmax:
+                ldmax = a
+            col[k] /= d
+            a = abs(col[k])
+            if a > lmax:
+                lmax = a
+        for k in range(1, m + 1):
+            c = col[k] * d
+            nxt = ab[j + k]
+            for r in range(m - k + 1):
+                nxt[r] -= c * col[k + r]
+    if not finite:
+        dmin = np.nan
+    return negative, dmin, ldmax, lmax
+
+
+@njit(reassociate=True)
+def _band_solve(ab, n, b, order, rhs, x):  # pragma: no cover - compiled
+    """Solve K x = rhs with the factors of :func:`_band_ldlt`; rhs, x of shape (n, m)."""
+    y = np.empty(n)
+    for c in range(rhs.shape[1]):
+        for i in range(n):
+            y[i] = rhs[order[i], c]
+        for j in range(n):  # L y = P rhs, column by column
+            m = min(b, n - 1 - j)
+            yj = y[j]
+            for k in range(1, m + 1):
+                y[j + k] -= ab[j, k] * yj
+        for j in range(n):
+            y[j] /= ab[j, 0]
+        for j in range(n - 1, -1, -1):  # Lᵀ x = z
+            m = min(b, n - 1 - j)
+            s = y[j]
+            for k in range(1, m + 1):
+                s -= ab[j, k] * y[j + k]
+            y[j] = s
+        for i in range(n):
+            x[order[i], c] = y[i]
+
+
 @njit(reassociate=True)
 def _solve(env, rowptr, first, n, order, b, x):  # pragma: no cover - compiled
     """Solve K x = b with K = Pᵀ L D Lᵀ P; b, x of shape (n, m), m right-hand sides."""
@@ -267,9 +375,12 @@ class EnvelopeFactorization:
         s = self.structure
         if b.shape[:1] != (s.n,) or b.ndim > 2:
             raise ValueError(f"expected {s.n} rows, got shape {b.shape}")
-        B = b.reshape(s.n, -1)
+        B = np.ascontiguousarray(b.reshape(s.n, -1))
         x = np.empty(B.shape)
-        _solve(self._env, s.rowptr, s.first, s.n, s.order, B, x)
+        if s.storage == "band":
+            _band_solve(self._env.reshape(s.n, -1), s.n, s.half_bandwidth, s.order, B, x)
+        else:
+            _solve(self._env, s.rowptr, s.first, s.n, s.order, B, x)
         return x.reshape(b.shape)
 
 
@@ -311,8 +422,12 @@ def factorize_envelope(
         raise SingularTangentError("tangent has non-finite entries")
     if kmax == 0.0:
         raise SingularTangentError("tangent is the zero matrix")
-    negative, dmin, ldmax, lmax = _ldlt(env, structure.rowptr, structure.first, n,
-                                        np.empty(n))
+    if structure.storage == "band":
+        negative, dmin, ldmax, lmax = _band_ldlt(env.reshape(n, -1), n,
+                                                 structure.half_bandwidth)
+    else:
+        negative, dmin, ldmax, lmax = _ldlt(env, structure.rowptr, structure.first, n,
+                                            np.empty(n))
     growth = max(ldmax / kmax, lmax)
     if (not np.isfinite(dmin) or dmin <= singular_rtol * n * kmax
             or not np.isfinite(growth) or growth > GROWTH_LIMIT):

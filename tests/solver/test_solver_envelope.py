@@ -28,8 +28,12 @@ def _variable_band(rng, n, widths):
     return (L + L.T + sp.diags(rng.normal(scale=3.0, size=n))).tocsr()
 
 
+@pytest.mark.parametrize("storage", ["envelope", "band"])
 @pytest.mark.parametrize("seed", range(10))
-def test_inertia_and_solve_on_random_indefinite_envelopes(seed):
+def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeypatch):
+    from sandwich.solver import envelope
+
+    monkeypatch.setattr(envelope, "BAND_ADVANTAGE", 0.0 if storage == "envelope" else 1e9)
     rng = np.random.default_rng(seed)
     n = int(rng.integers(8, 80))
     widths = rng.integers(0, 6, size=n)
@@ -38,7 +42,7 @@ def test_inertia_and_solve_on_random_indefinite_envelopes(seed):
     A.sort_indices()
     eig = np.linalg.eigvalsh(A.toarray())
     fac = factorize_envelope(A)
-    assert isinstance(fac, EnvelopeFactorization)
+    assert isinstance(fac, EnvelopeFactorization) and fac.structure.storage == storage
     assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
     b = rng.normal(size=(n, 2))
     x = fac.solve(b)
