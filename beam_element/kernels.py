@@ -247,56 +247,39 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
         if not want_k:
             continue
         Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
+        Ke = np.empty((n, n))
         Kww = np.dot(Hww, Qww)
         Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
         for i in range(ec):
             e = e0 + i
-            # (column a, column b, value) of every independent entry, physical (scaled)
+            # every entry (physical: scaled) into the element's dense block, then out
             for p in range(pu.shape[1]):
                 ia = ucols[pu[0, p]]
                 ib = ucols[pu[1, p]]
                 v = Kuu[i, p] * scale[i, ia] * scale[i, ib]
-                if blocks:
-                    K_out[e, ia, ib] = v
-                    K_out[e, ib, ia] = v
-                if scatter:
-                    s = slots[e, ia, ib]
-                    if s >= 0:
-                        data[s] += signs[e, ia, ib] * v
-                    if ia != ib:
-                        s = slots[e, ib, ia]
-                        if s >= 0:
-                            data[s] += signs[e, ib, ia] * v
+                Ke[ia, ib] = v
+                Ke[ib, ia] = v
             for p in range(pw.shape[1]):
                 ia = wcols[pw[0, p]]
                 ib = wcols[pw[1, p]]
                 v = Kww[i, p] * scale[i, ia] * scale[i, ib]
-                if blocks:
-                    K_out[e, ia, ib] = v
-                    K_out[e, ib, ia] = v
-                if scatter:
-                    s = slots[e, ia, ib]
-                    if s >= 0:
-                        data[s] += signs[e, ia, ib] * v
-                    if ia != ib:
-                        s = slots[e, ib, ia]
-                        if s >= 0:
-                            data[s] += signs[e, ib, ia] * v
+                Ke[ia, ib] = v
+                Ke[ib, ia] = v
             for a in range(nu):
                 ia = ucols[a]
                 for b in range(nw):
                     ib = wcols[b]
                     v = Kuw[i, a * nw + b] * scale[i, ia] * scale[i, ib]
-                    if blocks:
-                        K_out[e, ia, ib] = v
-                        K_out[e, ib, ia] = v
-                    if scatter:
-                        s = slots[e, ia, ib]
+                    Ke[ia, ib] = v
+                    Ke[ib, ia] = v
+            if blocks:
+                K_out[e] = Ke
+            if scatter:
+                for a in range(n):
+                    for b in range(n):
+                        s = slots[e, a, b]
                         if s >= 0:
-                            data[s] += signs[e, ia, ib] * v
-                        s = slots[e, ib, ia]
-                        if s >= 0:
-                            data[s] += signs[e, ib, ia] * v
+                            data[s] += signs[e, a, b] * Ke[a, b]
 
 
 @njit
