@@ -63,7 +63,7 @@ class EnvelopeStructure:
     order: np.ndarray  # (n,) new → old
     first: np.ndarray  # (n,) first column of row i (new numbering) in the envelope
     rowptr: np.ndarray  # (n + 1,) row i is env[rowptr[i]: rowptr[i + 1]], columns first[i]..i
-    slots: np.ndarray  # CSR slots of the lower-triangle (new numbering) entries …
+    slots: np.ndarray  # CSR slots of the stored triangle's entries (new numbering) …
     positions: np.ndarray  # … and their positions in env
     indptr: np.ndarray  # the pattern it was built for
     indices: np.ndarray
@@ -131,18 +131,22 @@ class EnvelopeStructure:
         inv[order] = np.arange(n)
         rows = np.repeat(np.arange(n), np.diff(indptr))
         i, j = inv[rows], inv[indices]
-        lower = np.flatnonzero(j <= i)
         b = int(np.max(np.arange(n) - first)) if n else 0
         # A fixed band does the zeros inside it too, but as contiguous AXPYs that vectorise
         # (measured ≈ 3× the rate of the envelope's short dot products): take it while it costs
         # less than BAND_ADVANTAGE × the envelope's operations.
         band = _band_flops(n, b) <= BAND_ADVANTAGE * float(_count_flops(first, n))
-        if band:  # ab[j, k] = K[j + k, j]
-            positions = j[lower] * (b + 1) + (i[lower] - j[lower])
+        # Each storage is filled from the triangle whose CSR rows it stores contiguously (K is
+        # symmetric): the band's column j = K[j, j:j + b] (upper), the envelope's row i
+        # = K[i, first_i:i + 1] (lower).
+        if band:  # ab[j, k] = K[j + k, j] = K[j, j + k]
+            kept = np.flatnonzero(j >= i)
+            positions = i[kept] * (b + 1) + (j[kept] - i[kept])
         else:
-            positions = rowptr[i[lower]] + (j[lower] - first[i[lower]])
+            kept = np.flatnonzero(j <= i)
+            positions = rowptr[i[kept]] + (j[kept] - first[i[kept]])
         return cls(n=n, order=order, first=first.astype(np.int64), rowptr=rowptr,
-                   slots=lower.astype(np.int64), positions=positions.astype(np.int64),
+                   slots=kept.astype(np.int64), positions=positions.astype(np.int64),
                    indptr=indptr, indices=indices, ordering=name,
                    storage="band" if band else "envelope")
 
@@ -190,18 +194,20 @@ def _count_flops(first, n):  # pragma: no cover - compiled
 
 @njit
 def _load(data, slots, positions, size):  # pragma: no cover - compiled
-    """Envelope of the lower triangle from CSR values, and max |K| (NaN if one is not finite)."""
+    """Storage filled from the stored triangle's CSR values, and their max |K|.
+
+    NaN instead of the max if one value is not finite; K is symmetric, so this is max |K|.
+    """
     env = np.zeros(size)
-    for t in range(slots.size):
-        env[positions[t]] = data[slots[t]]
     kmax = 0.0
-    for t in range(data.size):
-        a = abs(data[t])
-        if not (a <= 1.0e308):
-            return env, np.nan
-        if a > kmax:
-            kmax = a
-    return env, kmax
+    finite = True
+    for t in range(slots.size):
+        v = data[slots[t]]
+        env[positions[t]] = v
+        a = abs(v)
+        finite &= a <= 1.0e308
+        kmax = a if a > kmax else kmax
+    return env, (kmax if finite else np.nan)
 
 
 @njit(reassociate=True)
@@ -394,7 +400,7 @@ def factorize_envelope(
     Parameters
     ----------
     K
-        Symmetric matrix (CSR preferred; only its lower triangle is read).
+        Symmetric matrix (CSR preferred; one triangle is read).
     structure
         Symbolic part for K's pattern (computed if omitted or if it does not match).
     singular_rtol
