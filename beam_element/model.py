@@ -300,13 +300,15 @@ class BeamModel:
             st = layer_state(op, u_e, lengths[els], self.width)
             forces.append(st.f)
             kernels.scatter_blocks(layer_tangent(op, st, products), *slots[i], data)
+        contact = []
         for j, pairs in enumerate(self.pairs, start=len(families)):
-            f, K, _, _ = penalty_response(pairs, u_full, self.penalty, self.smoothing)
+            f, K, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(f)
+            contact.append((p, k))
             kernels.scatter_blocks(np.ascontiguousarray(K), *slots[j], data)
         n = self.pattern.n
         K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
-        return scatter_vector(u_full.size, self.block_dofs, forces), _Assembled(K)
+        return scatter_vector(u_full.size, self.block_dofs, forces), _Assembled(K, contact)
 
     def _tangent_blocks(
         self, u_full: np.ndarray, states: list[list[LayerState]]
@@ -332,8 +334,14 @@ class BeamModel:
         """Penetration, pressure and sliding per interface at free DOFs ``u``."""
         u_full = self.expand(u)
         out: dict[str, ContactSummary] = {}
-        for pairs in self.pairs:  # an interface may hold several groups (contact_pair_groups)
-            _, _, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
+        cache = self._cache  # the last evaluation's contact, if it was at this u
+        known = (cache[3].contact if cache is not None and isinstance(cache[3], _Assembled)
+                 and np.array_equal(cache[0], u) else None)
+        for i, pairs in enumerate(self.pairs):  # an interface may hold several groups
+            if known is not None:
+                p, k = known[i]
+            else:
+                _, _, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             active = in_contact(k.gap, self.smoothing)
             c = out.setdefault(pairs.interface, ContactSummary())
             c.max_penetration = max(c.max_penetration, float(np.max(-k.gap, initial=0.0)))
@@ -352,9 +360,14 @@ class BeamModel:
 
 @dataclass(frozen=True)
 class _Assembled:
-    """What the compiled path keeps of a force evaluation: the reduced tangent at its u."""
+    """What the compiled path keeps of a force evaluation at its u.
+
+    The reduced tangent and, per contact group, the pressures and kinematics (reused by
+    :meth:`BeamModel.contact_summary`).
+    """
 
     K: sp.csr_matrix
+    contact: list = field(default_factory=list)
 
 
 _KERNELS: list = []

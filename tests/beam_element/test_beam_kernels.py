@@ -146,6 +146,17 @@ def test_compiled_force_carries_its_tangent():
     assert model.residual_roundoff(u) > 0 and model.tangent(u) is K
 
 
+def test_contact_summary_reuses_the_evaluation_and_agrees():
+    scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
+    model = build_model(scene)
+    u = _contact_state(model, np.random.default_rng(4))
+    fresh = model.contact_summary(u)  # nothing evaluated yet at u
+    model.internal_force(u)
+    assert model._cache[3].contact  # kept by the evaluation
+    assert model.contact_summary(u) == fresh
+    assert fresh["top"].active > 0
+
+
 def test_beam_tangent_inertia_matches_superlu_along_a_shift():
     """On a beam tangent with a bifurcation-like shift, both backends count the same."""
     scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
