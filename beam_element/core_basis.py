@@ -92,7 +92,8 @@ class CoreBasis:
         if self.family not in CORE_BASES:
             raise ValueError(f"core basis must be one of {CORE_BASES}, got {self.family!r}")
         if not (isinstance(self.max_level, int | np.integer) and 1 <= self.max_level <= MAX_LEVEL):
-            raise ValueError(f"core level must be an integer 1..{MAX_LEVEL}, got {self.max_level!r}")
+            raise ValueError(
+                f"core level must be an integer 1..{MAX_LEVEL}, got {self.max_level!r}")
 
     @cached_property
     def functions(self) -> tuple[Enrichment, ...]:
