@@ -105,7 +105,8 @@ def one(case: str, variant: str, elements: int | None) -> dict:
         counts[int(e)] = counts.get(int(e), 0) + 1
     return dict(case=case, variant=variant, elements=r.model.mesh.n_elements, dofs=s.dofs,
                 levels=" ".join(f"L{k}:{v}" for k, v in sorted(counts.items())),
-                estimate="" if core["estimated_error"] is None else f"{core['estimated_error']:.4g}",
+                estimate=("" if core["estimated_error"] is None
+                          else f"{core['estimated_error']:.4g}"),
                 lambda_end=f"{s.history[-1].load_factor:.6g}", reached=s.converged,
                 steps=len(s.history), iterations=s.extra["total_newton_iterations"],
                 seconds=f"{seconds:.2f}", load=f"{load:.2f}")
