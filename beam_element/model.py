@@ -197,13 +197,37 @@ class BeamModel:
                 return _SpluFactorization(K)
             return SparseFactorization(K)
         K = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
-        known = self.__dict__.setdefault("_envelopes", [])  # the model's pattern, linear ones
+        known = self.__dict__.setdefault("_envelopes", [])  # the model's pattern first
         structure = next((s for s in known if s.matches(K)), None)
         if structure is None:
+            embedded = self._on_pattern(K)  # e.g. K0 + linear contact: sums drop zeros
+            if embedded is not None:
+                K = embedded
+                structure = next((s for s in known if s.matches(K)), None)
+        if structure is None:
             structure = EnvelopeStructure.of(K)
-            known.append(structure)
-            del known[:-4]
+            known.insert(1 if known else 0, structure)  # keep the model's own pattern's
+            del known[4:]
         return factorize_envelope(K, structure)
+
+    def _on_pattern(self, K: sp.csr_matrix) -> sp.csr_matrix | None:
+        """``K`` with the model's reduced sparsity pattern, if its non-zeros lie inside it."""
+        p = self.pattern
+        if K.shape != (p.n, p.n):
+            return None
+        keys = self.__dict__.get("_pattern_keys")
+        if keys is None:  # row-major, sorted (the pattern's CSR is canonical)
+            keys = np.repeat(np.arange(p.n, dtype=np.int64), np.diff(p.indptr)) * p.n + p.indices
+            self._pattern_keys = keys
+        K = K.copy() if not K.has_canonical_format else K
+        K.sum_duplicates()
+        k = np.repeat(np.arange(p.n, dtype=np.int64), np.diff(K.indptr)) * p.n + K.indices
+        at = np.searchsorted(keys, k)
+        if np.any(at >= keys.size) or not np.array_equal(keys[np.minimum(at, keys.size - 1)], k):
+            return None
+        data = np.zeros(keys.size)
+        data[at] = K.data
+        return sp.csr_matrix((data, p.indices, p.indptr), shape=K.shape)
 
     def probe_vector(self, name: str) -> np.ndarray:
         """C on the free DOFs with probe value c · u (mm)."""

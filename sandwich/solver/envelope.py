@@ -40,18 +40,31 @@ from sandwich.solver.sparse import GROWTH_LIMIT, SingularTangentError, SparseFac
 __all__ = ["EnvelopeFactorization", "EnvelopeStructure", "factorize_envelope"]
 
 
-def _envelope_first(indptr: np.ndarray, indices: np.ndarray, order: np.ndarray) -> np.ndarray:
-    """first[i] of the matrix permuted by ``order`` (new → old), from its CSR pattern."""
+def _row_min(indptr: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """Minimum of ``values`` over each CSR row (rows without entries: a large number)."""
+    out = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
+    rows = np.flatnonzero(np.diff(indptr) > 0)
+    if rows.size:
+        out[rows] = np.minimum.reduceat(values, indptr[rows])
+    return out
+
+
+def _envelope_first(
+    indptr: np.ndarray, indices: np.ndarray, order: np.ndarray,
+    t_indptr: np.ndarray, t_indices: np.ndarray,
+) -> np.ndarray:
+    """first[r] of the matrix permuted by ``order`` (new → old).
+
+    From its CSR pattern and the pattern of its transpose (``t_*``): the smallest new column
+    index in new row r over either triangle (an unsymmetric pattern gets the envelope of its
+    symmetric closure).
+    """
     n = indptr.size - 1
     inv = np.empty(n, dtype=np.int64)
     inv[order] = np.arange(n)
-    rows = np.repeat(np.arange(n), np.diff(indptr))
-    i, j = inv[rows], inv[indices]
-    first = np.arange(n)
-    lower = j < i
-    np.minimum.at(first, i[lower], j[lower])
-    upper = i < j  # the pattern may be stored as the full symmetric matrix or not: use both
-    np.minimum.at(first, j[upper], i[upper])
+    m = np.minimum(_row_min(indptr, inv[indices], n), _row_min(t_indptr, inv[t_indices], n))
+    first = np.empty(n, dtype=np.int64)
+    first[inv] = np.minimum(inv, m)  # old row i is new row inv[i]
     return first
 
 
@@ -111,6 +124,8 @@ class EnvelopeStructure:
         K = _canonical_csr(K)
         n = K.shape[0]
         indptr, indices = K.indptr, K.indices
+        T = K.tocsc()  # the transpose's CSR pattern
+        t_indptr, t_indices = T.indptr, T.indices
         candidates = {"natural": np.arange(n)}
         if n > 1:
             candidates["rcm"] = np.asarray(
@@ -119,7 +134,7 @@ class EnvelopeStructure:
                 dtype=np.int64)
         best = None
         for name, order in candidates.items():
-            first = _envelope_first(indptr, indices, order)
+            first = _envelope_first(indptr, indices, order, t_indptr, t_indices)
             p = np.arange(n) - first
             cost = float(np.sum(p * p))
             if best is None or cost < 0.9 * best[0]:  # natural unless RCM is clearly better
