@@ -28,12 +28,31 @@ class GeometricProducts:
 
     ``xx = N,ηᵀN,η + M,ηᵀM,η``, ``zz = N,ξᵀN,ξ + M,ξᵀM,ξ`` and
     ``xz = N,ξᵀN,η + N,ηᵀN,ξ + M,ξᵀM,η + M,ηᵀM,ξ``; the physical ones are these times
-    (2/l)², (2/h)² and (2/l)(2/h).
+    (2/l)², (2/h)² and (2/l)(2/h). Computed on first use (only the ``membrane_average`` tangent
+    needs them; at high core levels they are large: G n² per product).
     """
 
-    xx: np.ndarray
-    zz: np.ndarray
-    xz: np.ndarray
+    op: LayerOperators
+
+    @staticmethod
+    def _outer(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        return np.einsum("ga,gb->gab", A, B)
+
+    @cached_property
+    def xx(self) -> np.ndarray:
+        """N,ηᵀN,η + M,ηᵀM,η."""
+        return self._outer(self.op.N_eta, self.op.N_eta) + self._outer(self.op.M_eta, self.op.M_eta)
+
+    @cached_property
+    def zz(self) -> np.ndarray:
+        """N,ξᵀN,ξ + M,ξᵀM,ξ."""
+        return self._outer(self.op.N_xi, self.op.N_xi) + self._outer(self.op.M_xi, self.op.M_xi)
+
+    @cached_property
+    def xz(self) -> np.ndarray:
+        """N,ξᵀN,η + N,ηᵀN,ξ + M,ξᵀM,η + M,ηᵀM,ξ."""
+        xz = self._outer(self.op.N_xi, self.op.N_eta) + self._outer(self.op.M_xi, self.op.M_eta)
+        return xz + xz.transpose(0, 2, 1)
 
     @cached_property
     def stacked(self) -> np.ndarray:
@@ -43,17 +62,8 @@ class GeometricProducts:
 
 
 def geometric_products(op: LayerOperators) -> GeometricProducts:
-    """Precompute the element-independent products of eq. (25) for one layer's rule."""
-
-    def outer(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        return np.einsum("ga,gb->gab", A, B)
-
-    xz = outer(op.N_xi, op.N_eta) + outer(op.M_xi, op.M_eta)
-    return GeometricProducts(
-        xx=outer(op.N_eta, op.N_eta) + outer(op.M_eta, op.M_eta),
-        zz=outer(op.N_xi, op.N_xi) + outer(op.M_xi, op.M_xi),
-        xz=xz + xz.transpose(0, 2, 1),
-    )
+    """The element-independent products of eq. (25) for one layer's rule (computed lazily)."""
+    return GeometricProducts(op)
 
 
 def _eta_weights(op: LayerOperators) -> np.ndarray:

@@ -34,7 +34,8 @@ import numpy as np
 from beam_element.layer_operators import LayerOperators
 from sandwich.solver.jit import njit
 
-__all__ = ["KernelOperators", "kernel_operators", "layer_assemble", "layer_response",
+__all__ = ["KernelOperators", "kernel_operators", "layer_assemble", "layer_blocks",
+           "layer_response",
            "point_flops", "scatter_blocks", "supports"]
 
 
@@ -341,6 +342,20 @@ def layer_response(
     K = np.empty((E, n, n)) if tangent else _NO_BLOCKS
     f = _run(op, np.asarray(u_e)[:, op.dofs], lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS,
              _NO_DATA)
+    return f, (K if tangent else None)
+
+
+def layer_blocks(
+    op: LayerOperators, u_l: np.ndarray, lengths: np.ndarray, width: float,
+    tangent: bool = True,
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Force ``(E, n)`` and tangent blocks ``(E, n, n)`` from the layer's DOF values ``u_l``.
+
+    As :func:`layer_response`, with ``u_l = u_e[:, op.dofs]`` already gathered.
+    """
+    E, n = np.shape(u_l)[0], op.dofs.size
+    K = np.empty((E, n, n)) if tangent else _NO_BLOCKS
+    f = _run(op, u_l, lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS, _NO_DATA)
     return f, (K if tangent else None)
 
 

@@ -349,10 +349,30 @@ class BeamModel:
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Internal force on the full DOFs and the local tangent blocks (layers, then contact).
 
-        Evaluated by the NumPy reference path (:mod:`beam_element.element`).
+        Layers by the compiled kernels (block output) when :attr:`use_kernels` and numba allow,
+        else by the NumPy reference path (:mod:`beam_element.element`).
         """
-        f_full, states = self._forces(u_full, compiled=False)
-        return f_full, (self._tangent_blocks(u_full, states) if tangent else [])
+        kernels = _kernels() if self.use_kernels else None
+        if kernels is None:
+            f_full, states = self._forces(u_full, compiled=False)
+            return f_full, (self._tangent_blocks(u_full, states) if tangent else [])
+        forces, blocks = [], []
+        lengths = self.mesh.lengths
+        for op, products, els, dofs in self._families():
+            if kernels.supports(op):
+                f, K = kernels.layer_blocks(op, u_full[dofs], lengths[els], self.width, tangent)
+            else:
+                u_e = np.zeros((els.size, int(op.dofs.max()) + 1))
+                u_e[:, op.dofs] = u_full[dofs]
+                st = layer_state(op, u_e, lengths[els], self.width)
+                f, K = st.f, (layer_tangent(op, st, products) if tangent else None)
+            forces.append(f)
+            blocks.append(K)
+        for pairs in self.pairs:
+            f, K, _, _ = penalty_response(pairs, u_full, self.penalty, self.smoothing)
+            forces.append(f)
+            blocks.append(K)
+        return scatter_vector(u_full.size, self.block_dofs, forces), (blocks if tangent else [])
 
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
         """Penetration, pressure and sliding per interface at free DOFs ``u``."""

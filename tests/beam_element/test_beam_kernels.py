@@ -134,6 +134,13 @@ def test_model_compiled_path_matches_numpy_path(options):
     assert np.linalg.norm(f1 - f0) <= 1e-13 * np.linalg.norm(f0)
     assert abs(K1 - K0).max() <= 1e-13 * abs(K0).max()
     assert K1.nnz == K0.nnz
+    u_full = model.expand(u)
+    g1, b1 = model.full_response(u_full)
+    model.use_kernels = False
+    g0, b0 = model.full_response(u_full)
+    assert np.linalg.norm(g1 - g0) <= 1e-13 * np.linalg.norm(g0)
+    for x, y in zip(b1, b0, strict=True):
+        assert np.max(np.abs(x - y)) <= 1e-13 * np.max(np.abs(y))
 
 
 def test_compiled_force_carries_its_tangent():
