@@ -34,7 +34,8 @@ import numpy as np
 from beam_element.layer_operators import LayerOperators
 from sandwich.solver.jit import njit
 
-__all__ = ["KernelOperators", "kernel_operators", "layer_assemble", "layer_blocks",
+__all__ = ["KernelOperators", "embed_pattern", "kernel_operators", "layer_assemble",
+           "layer_blocks",
            "layer_response",
            "point_flops", "scatter_blocks", "supports"]
 
@@ -84,7 +85,7 @@ def _packed_products(A0, A1, B0, B1, symmetric):
         q = [A0[:, a] * A0[:, b], A1[:, a] * A1[:, b],
              A0[:, a] * A1[:, b] + A1[:, a] * A0[:, b]]
         return np.ascontiguousarray(np.concatenate(q)), np.array([a, b], dtype=np.int64)
-    q = [np.einsum("ga,gb->gab", X, Y).reshape(X.shape[0], -1)
+    q = [(X[:, :, None] * Y[:, None, :]).reshape(X.shape[0], -1)
          for X, Y in ((A0, B0), (A0, B1), (A1, B0), (A1, B1))]
     return np.ascontiguousarray(np.concatenate(q)), None
 
@@ -281,6 +282,26 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
                         s = slots[e, a, b]
                         if s >= 0:
                             data[s] += signs[e, a, b] * Ke[a, b]
+
+
+@njit
+def embed_pattern(indptr, indices, k_indptr, k_indices, k_data, out):  # pragma: no cover
+    """Values of a CSR matrix K placed on a larger CSR pattern (both with sorted rows).
+
+    ``out`` (zeros, one per pattern slot) receives K's values; returns False (``out``
+    incomplete) if an entry of K is not in the pattern.
+    """
+    for r in range(indptr.size - 1):
+        p = indptr[r]
+        p_end = indptr[r + 1]
+        for t in range(k_indptr[r], k_indptr[r + 1]):
+            c = k_indices[t]
+            while p < p_end and indices[p] < c:
+                p += 1
+            if p == p_end or indices[p] != c:
+                return False
+            out[p] += k_data[t]
+    return True
 
 
 @njit

@@ -213,20 +213,16 @@ class BeamModel:
     def _on_pattern(self, K: sp.csr_matrix) -> sp.csr_matrix | None:
         """``K`` with the model's reduced sparsity pattern, if its non-zeros lie inside it."""
         p = self.pattern
-        if K.shape != (p.n, p.n):
+        kernels = _kernels()
+        if K.shape != (p.n, p.n) or kernels is None:
             return None
-        keys = self.__dict__.get("_pattern_keys")
-        if keys is None:  # row-major, sorted (the pattern's CSR is canonical)
-            keys = np.repeat(np.arange(p.n, dtype=np.int64), np.diff(p.indptr)) * p.n + p.indices
-            self._pattern_keys = keys
-        K = K.copy() if not K.has_canonical_format else K
-        K.sum_duplicates()
-        k = np.repeat(np.arange(p.n, dtype=np.int64), np.diff(K.indptr)) * p.n + K.indices
-        at = np.searchsorted(keys, k)
-        if np.any(at >= keys.size) or not np.array_equal(keys[np.minimum(at, keys.size - 1)], k):
+        if not K.has_canonical_format:
+            K = K.copy()
+            K.sum_duplicates()
+        data = np.zeros(p.indices.size)
+        if not kernels.embed_pattern(p.indptr, p.indices, K.indptr, K.indices,
+                                     np.asarray(K.data, dtype=float), data):
             return None
-        data = np.zeros(keys.size)
-        data[at] = K.data
         return sp.csr_matrix((data, p.indices, p.indptr), shape=K.shape)
 
     def probe_vector(self, name: str) -> np.ndarray:

@@ -204,3 +204,22 @@ def test_beam_path_imports_no_2d_or_plotting_stack():
                          timeout=300, cwd=here)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"
+
+
+def test_a_matrix_inside_the_model_pattern_reuses_its_factorisation_structure():
+    model = build_model(sandwich_scene(length=60.0, elements=8,
+                                       debonds=(Debond("top", 15.0, 45.0),)))
+    K = model.tangent(np.zeros(model.size))
+    model.factorize(K)
+    sub = sp.csr_matrix(K.toarray() * (np.random.default_rng(0).random(K.shape) < 0.5))
+    sub = sub + sub.T + sp.diags(K.diagonal())  # symmetric, fewer non-zeros than K
+    on = model._on_pattern(sub.tocsr())
+    assert on is not None and on.nnz == K.nnz
+    assert np.array_equal(on.toarray(), sub.toarray())
+    fac = model.factorize(sub.tocsr())
+    assert len(model._envelopes) == 1  # no new symbolic factorisation
+    b = np.ones(model.size)
+    assert np.allclose(sub @ fac.solve(b), b, rtol=0, atol=1e-8 * np.abs(b).max())
+    outside = sp.csr_matrix(K + sp.eye(model.size, k=model.size - 1) + sp.eye(model.size,
+                                                                              k=1 - model.size))
+    assert model._on_pattern(outside.tocsr()) is None
