@@ -65,15 +65,38 @@ def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPat
     r, c = dof_map.free[rows], dof_map.free[cols]
     keep = (r >= 0) & (c >= 0)
     n = dof_map.n_free
-    keys = r[keep].astype(np.int64) * n + c[keep]
-    unique, slot = np.unique(keys, return_inverse=True)
-    row_of = unique // n
-    indptr = np.searchsorted(row_of, np.arange(n + 1))
+    r, c = r[keep], c[keep]
+    locate = _slot_search()
+    if locate is None:  # no numba: sort the keys
+        keys = r.astype(np.int64) * n + c
+        unique, slot = np.unique(keys, return_inverse=True)
+        row_of = unique // n
+        indptr = np.searchsorted(row_of, np.arange(n + 1)).astype(np.int32)
+        indices = (unique % n).astype(np.int32)
+    else:  # the same canonical CSR pattern from scipy's COO -> CSR, then one search per entry
+        P = sp.csr_matrix((np.ones(r.size), (r, c)), shape=(n, n))
+        P.sum_duplicates()
+        indptr, indices = P.indptr.astype(np.int32), P.indices.astype(np.int32)
+        slot = locate(indptr, indices, r.astype(np.int64), c.astype(np.int64))
     return ReducedPattern(
         block_dofs=tuple(block_dofs), slot=slot, keep=keep,
         weight=dof_map.sign[rows[keep]] * dof_map.sign[cols[keep]],
-        indices=(unique % n).astype(np.int32), indptr=indptr.astype(np.int32), n=n,
+        indices=indices, indptr=indptr, n=n,
     )
+
+
+_SLOT_SEARCH: list = []
+
+
+def _slot_search():
+    """Compiled slot search (:func:`beam_element.kernels.csr_slots`), or None without numba."""
+    if not _SLOT_SEARCH:
+        try:
+            from beam_element.kernels import csr_slots
+        except ImportError:
+            csr_slots = None
+        _SLOT_SEARCH.append(csr_slots)
+    return _SLOT_SEARCH[0]
 
 
 def scatter_vector(

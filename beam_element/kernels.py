@@ -34,7 +34,7 @@ import numpy as np
 from beam_element.layer_operators import LayerOperators
 from sandwich.solver.jit import njit
 
-__all__ = ["KernelOperators", "embed_pattern", "kernel_operators", "layer_assemble",
+__all__ = ["KernelOperators", "csr_slots", "embed_pattern", "kernel_operators", "layer_assemble",
            "layer_blocks",
            "layer_response",
            "point_flops", "scatter_blocks", "supports"]
@@ -282,6 +282,24 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
                         s = slots[e, a, b]
                         if s >= 0:
                             data[s] += signs[e, a, b] * Ke[a, b]
+
+
+@njit
+def csr_slots(indptr, indices, rows, cols):  # pragma: no cover - compiled
+    """Slot of each entry (rows[t], cols[t]) in a canonical CSR pattern (binary search)."""
+    out = np.empty(rows.size, dtype=np.int64)
+    for t in range(rows.size):
+        lo = indptr[rows[t]]
+        hi = indptr[rows[t] + 1]
+        c = cols[t]
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if indices[mid] < c:
+                lo = mid + 1
+            else:
+                hi = mid
+        out[t] = lo
+    return out
 
 
 @njit

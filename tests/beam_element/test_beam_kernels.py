@@ -223,3 +223,18 @@ def test_a_matrix_inside_the_model_pattern_reuses_its_factorisation_structure():
     outside = sp.csr_matrix(K + sp.eye(model.size, k=model.size - 1) + sp.eye(model.size,
                                                                               k=1 - model.size))
     assert model._on_pattern(outside.tocsr()) is None
+
+
+@pytest.mark.parametrize("options", [{}, {"core_level": 2}, {"contact_search": "closest-point"}])
+def test_reduced_pattern_is_the_same_with_and_without_the_compiled_search(options, monkeypatch):
+    from beam_element import assembly
+
+    scene = sandwich_scene(length=60.0, elements=12,
+                           debonds=(Debond("top", 15.0, 45.0), Debond("bottom", 0.0, 20.0)))
+    model = build_model(scene, **options)
+    fast = assembly.reduced_pattern(model.block_dofs, model.dof_map)
+    monkeypatch.setattr(assembly, "_SLOT_SEARCH", [None])  # the np.unique path
+    slow = assembly.reduced_pattern(model.block_dofs, model.dof_map)
+    for key in ("slot", "keep", "weight", "indices", "indptr"):
+        a, b = getattr(fast, key), getattr(slow, key)
+        assert a.dtype == b.dtype and np.array_equal(a, b), key
