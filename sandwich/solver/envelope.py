@@ -81,28 +81,28 @@ class EnvelopeStructure:
     indptr: np.ndarray  # the pattern it was built for
     indices: np.ndarray
     ordering: str  # "natural" or "rcm"
-    storage: str = "envelope"  # or "band": fixed half-band b, columns stored contiguously
+    storage: str = "envelope"  # or "columns": column j holds rows j..last[j], contiguously
+    last: np.ndarray | None = None  # (n,) "columns": last row of column j (non-decreasing)
+    colptr: np.ndarray | None = None  # (n + 1,) "columns": column j is env[colptr[j]:colptr[j+1]]
 
     @property
     def size(self) -> int:
         """Number of stored entries (diagonal included)."""
-        if self.storage == "band":
-            return self.n * (self.half_bandwidth + 1)
+        if self.storage == "columns":
+            return int(self.colptr[-1])
         return int(self.rowptr[-1])
 
     @property
     def flops(self) -> float:
         """Floating-point operations of one factorisation (multiply + add = 2), exactly."""
-        if self.storage == "band":
-            return _band_flops(self.n, self.half_bandwidth)
+        if self.storage == "columns":
+            return _column_flops(self.last)
         return float(_count_flops(self.first, self.n))
 
     @property
     def solve_flops(self) -> float:
         """Floating-point operations of one solve with one right-hand side."""
-        off = self.size - self.n if self.storage == "envelope" else _band_entries(
-            self.n, self.half_bandwidth)
-        return float(4 * off + self.n)
+        return float(4 * (self.size - self.n) + self.n)
 
     @cached_property
     def half_bandwidth(self) -> int:
@@ -146,42 +146,53 @@ class EnvelopeStructure:
         inv[order] = np.arange(n)
         rows = np.repeat(np.arange(n), np.diff(indptr))
         i, j = inv[rows], inv[indices]
-        b = int(np.max(np.arange(n) - first)) if n else 0
-        # A fixed band does the zeros inside it too, but as contiguous AXPYs that vectorise
-        # (measured ≈ 3× the rate of the envelope's short dot products): take it while it costs
-        # less than BAND_ADVANTAGE × the envelope's operations.
-        band = _band_flops(n, b) <= BAND_ADVANTAGE * float(_count_flops(first, n))
+        last = _column_last(first)
+        # Column storage does the zeros between a column's rows too (rows i > j whose first[i]
+        # is above j), but as contiguous AXPYs that vectorise (measured ≈ 3× the rate of the
+        # row envelope's short dot products): take it while it costs less than
+        # COLUMN_ADVANTAGE × the envelope's operations.
+        columns = _column_flops(last) <= COLUMN_ADVANTAGE * float(_count_flops(first, n))
+        colptr = np.zeros(n + 1, dtype=np.int64)
+        colptr[1:] = np.cumsum(last - np.arange(n) + 1)
         # Each storage is filled from the triangle whose CSR rows it stores contiguously (K is
-        # symmetric): the band's column j = K[j, j:j + b] (upper), the envelope's row i
+        # symmetric): column j = K[j, j:last_j + 1] (upper), the envelope's row i
         # = K[i, first_i:i + 1] (lower).
-        if band:  # ab[j, k] = K[j + k, j] = K[j, j + k]
+        if columns:  # env[colptr[j] + (i − j)] = K[i, j] = K[j, i]
             kept = np.flatnonzero(j >= i)
-            positions = i[kept] * (b + 1) + (j[kept] - i[kept])
+            positions = colptr[i[kept]] + (j[kept] - i[kept])
         else:
             kept = np.flatnonzero(j <= i)
             positions = rowptr[i[kept]] + (j[kept] - first[i[kept]])
         return cls(n=n, order=order, first=first.astype(np.int64), rowptr=rowptr,
                    slots=kept.astype(np.int64), positions=positions.astype(np.int64),
                    indptr=indptr, indices=indices, ordering=name,
-                   storage="band" if band else "envelope")
+                   storage="columns" if columns else "envelope",
+                   last=last if columns else None, colptr=colptr if columns else None)
 
 
-#: A fixed band is used when its operation count is at most this multiple of the envelope's.
-BAND_ADVANTAGE = 2.5
+#: Column storage is used when its operation count is at most this multiple of the envelope's.
+COLUMN_ADVANTAGE = 2.5
 
 
-def _band_entries(n: int, b: int) -> int:
-    """Off-diagonal entries of an n×n band of half-width b (lower triangle)."""
-    return n * b - b * (b + 1) // 2 if n > b else n * (n - 1) // 2
+def _column_last(first: np.ndarray) -> np.ndarray:
+    """last[j] = the largest row i with first[i] ≤ j (at least j): non-decreasing in j.
 
-
-def _band_flops(n: int, b: int) -> float:
-    """Operations of :func:`_band_ldlt`.
-
-    Per column j with m = min(b, n − 1 − j) entries below the diagonal: m divisions, m products
-    and m(m + 1)/2 multiply-adds.
+    Every entry (i, k) the factor can fill (first[i] ≤ k ≤ i) lies in column k above
+    last[k], and last[k] ≥ last[j] for k > j: the right-looking updates stay in the columns.
     """
-    m = np.minimum(b, n - 1 - np.arange(n)).astype(float)
+    n = first.size
+    top = np.full(n, -1, dtype=np.int64)
+    np.maximum.at(top, first, np.arange(n))  # n entries: cheap
+    return np.maximum(np.maximum.accumulate(top), np.arange(n))
+
+
+def _column_flops(last: np.ndarray) -> float:
+    """Operations of :func:`_column_ldlt`.
+
+    Per column j with m = last[j] − j entries below the diagonal: m divisions, m products and
+    m(m + 1)/2 multiply-adds.
+    """
+    m = (last - np.arange(last.size)).astype(float)
     return float(np.sum(2 * m + m * (m + 1)))
 
 
@@ -276,11 +287,11 @@ def _ldlt(env, rowptr, first, n, w):  # pragma: no cover - compiled
 
 
 @njit
-def _band_ldlt(ab, n, b):  # pragma: no cover - compiled
-    """In-place LDLᵀ of a band stored by columns, ab[j, k] = K[j + k, j] (right-looking).
+def _column_ldlt(env, colptr, last, n):  # pragma: no cover - compiled
+    """In-place LDLᵀ in column storage, env[colptr[j] + (i − j)] = K[i, j] (right-looking).
 
-    Column j: d_j = ab[j, 0], l_kj = ab[j, k] / d_j, then every later column j + k loses
-    l_kj d_j l_(k..b)j: contiguous AXPYs. Same returns as :func:`_ldlt`.
+    Column j: d_j = K[j, j], l_ij = K[i, j] / d_j, then every later column k ≤ last[j] loses
+    l_kj d_j l_(k..last_j) j: contiguous AXPYs. Same returns as :func:`_ldlt`.
     """
     negative = 0
     finite = True
@@ -288,7 +299,8 @@ def _band_ldlt(ab, n, b):  # pragma: no cover - compiled
     ldmax = 0.0
     lmax = 0.0
     for j in range(n):
-        d = ab[j, 0]
+        cj = colptr[j]
+        d = env[cj]
         ad = abs(d)
         if not (ad <= 1.0e308):
             finite = False
@@ -298,45 +310,46 @@ def _band_ldlt(ab, n, b):  # pragma: no cover - compiled
             ldmax = ad
         if d < 0.0:
             negative += 1
-        m = min(b, n - 1 - j)
-        col = ab[j]
+        m = last[j] - j
         for k in range(1, m + 1):
-            a = abs(col[k])  # (L D)_(j+k) j
+            a = abs(env[cj + k])  # (L D)_(j+k) j
             if a > ldmax:
                 ldmax = a
-            col[k] /= d
-            a = abs(col[k])
+            env[cj + k] /= d
+            a = abs(env[cj + k])
             if a > lmax:
                 lmax = a
+        col = env[cj:cj + m + 1]
         for k in range(1, m + 1):
             c = col[k] * d
-            nxt = ab[j + k]
+            dst = env[colptr[j + k]:colptr[j + k] + m - k + 1]  # column j + k, rows ≤ last[j]
+            src = col[k:]
             for r in range(m - k + 1):
-                nxt[r] -= c * col[k + r]
+                dst[r] -= c * src[r]
     if not finite:
         dmin = np.nan
     return negative, dmin, ldmax, lmax
 
 
 @njit(reassociate=True)
-def _band_solve(ab, n, b, order, rhs, x):  # pragma: no cover - compiled
-    """Solve K x = rhs with the factors of :func:`_band_ldlt`; rhs, x of shape (n, m)."""
+def _column_solve(env, colptr, last, n, order, rhs, x):  # pragma: no cover - compiled
+    """Solve K x = rhs with the factors of :func:`_column_ldlt`; rhs, x of shape (n, m)."""
     y = np.empty(n)
     for c in range(rhs.shape[1]):
         for i in range(n):
             y[i] = rhs[order[i], c]
         for j in range(n):  # L y = P rhs, column by column
-            m = min(b, n - 1 - j)
+            cj = colptr[j]
             yj = y[j]
-            for k in range(1, m + 1):
-                y[j + k] -= ab[j, k] * yj
+            for k in range(1, last[j] - j + 1):
+                y[j + k] -= env[cj + k] * yj
         for j in range(n):
-            y[j] /= ab[j, 0]
+            y[j] /= env[colptr[j]]
         for j in range(n - 1, -1, -1):  # Lᵀ x = z
-            m = min(b, n - 1 - j)
+            cj = colptr[j]
             s = y[j]
-            for k in range(1, m + 1):
-                s -= ab[j, k] * y[j + k]
+            for k in range(1, last[j] - j + 1):
+                s -= env[cj + k] * y[j + k]
             y[j] = s
         for i in range(n):
             x[order[i], c] = y[i]
@@ -398,8 +411,8 @@ class EnvelopeFactorization:
             raise ValueError(f"expected {s.n} rows, got shape {b.shape}")
         B = np.ascontiguousarray(b.reshape(s.n, -1))
         x = np.empty(B.shape)
-        if s.storage == "band":
-            _band_solve(self._env.reshape(s.n, -1), s.n, s.half_bandwidth, s.order, B, x)
+        if s.storage == "columns":
+            _column_solve(self._env, s.colptr, s.last, s.n, s.order, B, x)
         else:
             _solve(self._env, s.rowptr, s.first, s.n, s.order, B, x)
         return x.reshape(b.shape)
@@ -443,9 +456,8 @@ def factorize_envelope(
         raise SingularTangentError("tangent has non-finite entries")
     if kmax == 0.0:
         raise SingularTangentError("tangent is the zero matrix")
-    if structure.storage == "band":
-        negative, dmin, ldmax, lmax = _band_ldlt(env.reshape(n, -1), n,
-                                                 structure.half_bandwidth)
+    if structure.storage == "columns":
+        negative, dmin, ldmax, lmax = _column_ldlt(env, structure.colptr, structure.last, n)
     else:
         negative, dmin, ldmax, lmax = _ldlt(env, structure.rowptr, structure.first, n,
                                             np.empty(n))

@@ -28,12 +28,12 @@ def _variable_band(rng, n, widths):
     return (L + L.T + sp.diags(rng.normal(scale=3.0, size=n))).tocsr()
 
 
-@pytest.mark.parametrize("storage", ["envelope", "band"])
+@pytest.mark.parametrize("storage", ["envelope", "columns"])
 @pytest.mark.parametrize("seed", range(10))
 def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeypatch):
     from sandwich.solver import envelope
 
-    monkeypatch.setattr(envelope, "BAND_ADVANTAGE", 0.0 if storage == "envelope" else 1e9)
+    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 0.0 if storage == "envelope" else 1e9)
     rng = np.random.default_rng(seed)
     n = int(rng.integers(8, 80))
     widths = rng.integers(0, 6, size=n)
