@@ -2,16 +2,20 @@
 
 A 1D model numbered node by node (the beam) has a tangent whose non-zeros hug the diagonal:
 row i couples to columns ``first[i] … i`` only, and the LDLᵀ factor of such a matrix fills in
-nowhere outside that *envelope*. Factorising inside the envelope costs Σᵢ (i − first[i])²/2
-multiply-adds, against n·b²/2 for a fixed band of half-width b (the wider rows of the contact
-pairs do not widen the whole band) and with none of a general sparse LU's symbolic overhead.
+nowhere outside that *envelope*. Factorising inside it costs about Σᵢ (i − first[i])²
+operations, against n·b² for a fixed band of half-width b (the wider rows of the contact pairs
+or of higher core levels do not widen the whole band), with none of a general sparse LU's
+symbolic overhead. Two storages (chosen per pattern by their operation counts,
+:data:`COLUMN_ADVANTAGE`): ``"columns"``, column j holding rows j … last[j] with last
+non-decreasing (a band is the special case), factorised right-looking by contiguous AXPYs
+(:func:`_column_ldlt`); ``"envelope"``, the row envelope exactly, factorised row by row by
+Crout's dot products (:func:`_ldlt`).
 
 The factorisation is the one :class:`sandwich.solver.sparse.SparseFactorization` asks SuperLU
 for — symmetric, without pivoting, so ``K = L D Lᵀ`` and, by Sylvester's law of inertia, the
 number of negative entries of D is the number of negative eigenvalues of K (what the path
-follower needs for bifurcations) — computed in the envelope by a compiled row-by-row Crout
-kernel (:func:`_ldlt`). It is trusted under the same tests as there: every pivot finite and
-above ``singular_rtol · n · max|K|`` and the factors' growth below
+follower needs for bifurcations). It is trusted under the same tests as there: every pivot
+finite and above ``singular_rtol · n · max|K|`` and the factors' growth below
 :data:`~sandwich.solver.sparse.GROWTH_LIMIT`. Otherwise :func:`factorize_envelope` falls back
 to :class:`~sandwich.solver.sparse.SparseFactorization` (SuperLU; a pivoting LU with unknown
 inertia when even that fails). LAPACK has no banded LDLᵀ with pivoting for indefinite matrices:
@@ -20,7 +24,7 @@ inertia when even that fails). LAPACK has no banded LDLᵀ with pivoting for ind
 eigenvalues (docs/beam_speed.md).
 
 The symbolic work — ordering (natural or reverse Cuthill-McKee, whichever has the smaller
-envelope), ``first``, the row pointers and the map from CSR slots to envelope positions — is an
+envelope), ``first``, the storage and the map from CSR slots to its positions — is an
 :class:`EnvelopeStructure`, computed once per sparsity pattern and reused for every matrix of
 that pattern. A symmetric permutation P K Pᵀ is congruent to K: the inertia does not depend on
 the ordering.
