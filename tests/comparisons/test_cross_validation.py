@@ -1,18 +1,23 @@
 """Cross-validation: the beam model against the 2D reference on three scenes (CI).
 
-Runs both real models: the beam at its scene default (240 graded elements, the paper's element)
-and the 2D reference at level "coarse" (within 1 % of level "medium" on these quantities, see
-docs/reference2d.md). Reference: the 2D model.
+Runs both real models: the beam at its scene default (240 graded elements, core levels "auto"
+at tolerance 1 %, docs/beam_element.md "Core levels") and the 2D reference at level "coarse"
+(within 1 % of level "medium" on these quantities, see docs/reference2d.md). Reference: the 2D
+model.
 
 Tolerances, and why (3 %, 5 % and 25 % were written before either model existed, from the
-issue's "a few percent" and "looser, stated"; none was loosened):
+issue's "a few percent" and "looser, stated"; none was loosened). With the core hierarchy they
+were tightened to the measured agreement (2026-12-01, auto against 2D coarse: load L2 0.57 %,
+0.78 %, 0.57 % and max 0.67 %, 0.83 %, 0.62 % on fig4, fig5, c2; window-averaged stress
+extremes within 16 % of the 2D's largest magnitude):
 
-- load-deflection curve, relative L2 over the common range ≤ 3 %, max ≤ 5 %.
+- load-deflection curve, relative L2 over the common range ≤ 1 %, max ≤ 1.5 % (was 3 %, 5 %
+  with the paper's element alone, which was 2.1 %, 2.5 % and 0.6 % off in L2).
 - interface σzz (top, bottom) and core τ: the profiles are averaged over a 5 mm window first,
   because at crack tips and where a clamped or pinned face sits on the free core the 2D stress is
   singular (its raw peak grows under refinement, see tests/comparisons/test_cmp_window.py), while
   the window average converges. The smallest and largest averaged values of each model must lie
-  within 25 % of the 2D's largest magnitude.
+  within 20 % of the 2D's largest magnitude (was 25 %).
 
 What changed after the first runs, and is said here: the fig5 case first ran to w = −5 mm and
 failed; it now runs to −2 mm (before the debonded face buckles) and the −5 mm run is kept as a
@@ -36,8 +41,8 @@ pytestmark = pytest.mark.dolfinx
 
 ROOT = Path(__file__).resolve().parents[2]
 REF_LEVEL = "coarse"
-LOAD_L2, LOAD_MAX = 0.03, 0.05
-STRESS_TOL = 0.25
+LOAD_L2, LOAD_MAX = 0.01, 0.015
+STRESS_TOL = 0.20
 WINDOW = 5.0  # mm
 STRESSES = ("sigma_zz_top", "sigma_zz_bottom", "tau_core")
 
