@@ -20,9 +20,9 @@ extremes within 16 % of the 2D's largest magnitude):
   within 20 % of the 2D's largest magnitude (was 25 %).
 
 What changed after the first runs, and is said here: the fig5 case first ran to w = −5 mm and
-failed; it now runs to −2 mm (before the debonded face buckles) and the −5 mm run is kept as a
-strict xfail (it fails loudly if the gap closes): past that buckling the 2D model softens and the
-converged beam stays about 7 % stiffer at w = −5 mm (docs/beam_vs_2d.md). Stress peaks were
+failed; it runs to −2 mm (before the debonded face buckles), and the −5 mm run, a strict xfail
+while the paper's element alone stayed about 7 % stiffer there (docs/beam_vs_2d.md), is a test
+again since the core hierarchy closed the gap to 1-1.5 %. Stress peaks were
 first compared raw, which is meaningless at the singular points named above.
 """
 
@@ -97,7 +97,11 @@ def test_beam_agrees_with_2d(tmp_path, name, until):
         assert abs(b.max() - r.max()) <= STRESS_TOL * scale, (col, b.max(), r.max(), scale)
 
 
-@pytest.mark.xfail(strict=True, reason="known gap: past the debonded face's buckling the "
-                   "converged beam is ~7 % stiffer than 2D at w = -5 mm (docs/beam_vs_2d.md)")
 def test_fig5_beyond_face_buckling(tmp_path):
-    _load_curve_agrees(_compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0))
+    """Past the debonded face's buckling (w = −5 mm): the paper's element alone was ~7 % too
+    stiff here (a strict xfail until the core hierarchy); with auto core levels it is within
+    the original 3 %/5 % (measured 2026-12-01: L2 1.0 %, max 1.5 % against 2D coarse)."""
+    cmp = _compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0)
+    load = cmp.metrics.curve("load_factor")
+    assert load is not None and load.l2_relative is not None, cmp.metrics.notes
+    assert load.l2_relative <= 0.03 and load.max_relative <= 0.05, load
