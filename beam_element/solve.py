@@ -210,13 +210,8 @@ def _follow(
     from sandwich.solver.path import PathOptions, follow_path
 
     a = scene.analysis
-    options = PathOptions(
-        control=a.control, until_load_factor=a.until_load_factor, until_probe=a.until_probe,
-        until_value=a.until_value, max_steps=a.max_steps,
-        initial_increment=a.initial_increment, min_increment=_min_increment(model, a),
-        max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations,
-        desired_iterations=DESIRED_ITERATIONS,
-    )
+    options = PathOptions.from_analysis(a, min_increment=_min_increment(model, a),
+                                        desired_iterations=DESIRED_ITERATIONS)
     result = follow_path(model, options, list(model.probe_rows), progress)
     states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
               for s in result.states]

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from comparisons.claims import ClaimResult, check_claims
-from comparisons.compare import DEFAULT_RESULTS, Comparison, compare
-from comparisons.runs import PROJECT_ROOT, Progress, Solver
+from comparisons.compare import Comparison, compare
+from models import PROJECT_ROOT, Progress, Solver
 from sandwich.results import atomic_write_text
 from sandwich.scene import Scene, load_scene
 
@@ -107,7 +107,7 @@ def write_report(comparisons: Mapping[str, Comparison], claims: Sequence[ClaimRe
 
 def gallery(scenes: Sequence[Scene | str | Path] | None, out_dir: str | Path, *,
             reuse: bool = True, progress: Progress | None = None,
-            results_root: str | Path = DEFAULT_RESULTS,
+            results_root: str | Path | None = None,
             solvers: Mapping[str, Solver] | None = None) -> Gallery:
     """Compare both models on every scene and write ``<out_dir>/report.md``.
 
@@ -116,7 +116,8 @@ def gallery(scenes: Sequence[Scene | str | Path] | None, out_dir: str | Path, *,
     scenes
         Scenes or scene files; ``None`` means the shipped ``scenes/paper-*.toml``.
     out_dir
-        One sub-folder per scene (see :func:`~comparisons.compare.compare`) and ``report.md``.
+        One sub-folder per scene (see :func:`~comparisons.compare.compare`; the models' results
+        inside it unless ``results_root`` is given) and ``report.md``.
     reuse, progress, results_root, solvers
         Passed to :func:`~comparisons.compare.compare`.
     """

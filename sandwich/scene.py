@@ -19,6 +19,11 @@ SUPPORT_SITES = ("top", "bottom", "faces")
 SUPPORT_TYPES = ("pin", "roller", "clamp")
 ANALYSIS_KINDS = ("linear", "nonlinear")
 CONTROLS = ("load", "displacement", "arc-length")
+GRADINGS = ("graded", "tips", "uniform")  # [beam_model] grading: the beam mesh along x
+FACE_MEMBRANES = ("paper", "averaged")  # [beam_model] face_membrane
+MESH_LEVELS = ("coarse", "medium", "fine", "explicit")  # [reference2d] level: the 2D mesh
+# Scene and probe names become folder and file names (results/<scene>/, load_<probe>.png)
+NAME_PATTERN = r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}"
 
 
 @dataclass(frozen=True)

@@ -7,14 +7,19 @@ bad scene is answered with one line per problem before any model does any work.
 from __future__ import annotations
 
 import difflib
+import re
 from pathlib import Path
 from typing import Any
 
 from sandwich.scene import (
     ANALYSIS_KINDS,
     CONTROLS,
+    FACE_MEMBRANES,
     FACES,
+    GRADINGS,
     INTERFACES,
+    MESH_LEVELS,
+    NAME_PATTERN,
     SUPPORT_SITES,
     SUPPORT_TYPES,
     Analysis,
@@ -154,6 +159,7 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
     r.table(data, "", TOP_KEYS, required=("name", "beam", "layers", "materials", "supports",
                                           "loads", "analysis"))
     name = r.string(data, "name", "", default="")
+    _check_name(r, name, "name")
     description = data.get("description", "")
     if not isinstance(description, str):
         r.fail("description", f"expected a string, got {_typename(description)}")
@@ -178,6 +184,15 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
                  debonds=tuple(debonds), supports=tuple(supports), loads=tuple(loads),
                  probes=tuple(probes), analysis=analysis, beam_model=beam_model,
                  reference2d=reference2d, source=source)
+
+
+def _check_name(r: Reader, name: Any, key: str) -> bool:
+    """Refuse a name that cannot be a folder or file name (it becomes one in the results)."""
+    if isinstance(name, str) and name and not re.fullmatch(NAME_PATTERN, name):
+        r.fail(key, f"'{name[:40]}' cannot name a result folder or file: use 1-100 letters, "
+               "digits, '.', '_' or '-', starting with a letter or digit")
+        return False
+    return True
 
 
 def _beam(r: Reader, tbl: Any) -> tuple[float, float]:
@@ -337,6 +352,8 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
         if t is None:
             continue
         name = r.string(t, "name", key)
+        if not _check_name(r, name, f"{key}.name"):
+            name = None
         on = r.choice(t, "on", key, FACES)
         x = _station(r, t, "x", key, L)
         if name is not None and any(p.name == name for p in out):
@@ -354,8 +371,8 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
                 required=("kind", "until"))
     if t is None:
         return Analysis()
-    kind = r.choice(t, "kind", key, ANALYSIS_KINDS, default="nonlinear")
-    control = r.choice(t, "control", key, CONTROLS, default="load")
+    kind = r.choice(t, "kind", key, ANALYSIS_KINDS, default=Analysis.kind)
+    control = r.choice(t, "control", key, CONTROLS, default=Analysis.control)
     until_probe = until_value = until_lf = None
     if "until" in t:
         u = r.table(t["until"], "analysis.until", ("probe", "value", "load_factor"))
@@ -382,20 +399,21 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     if control == "displacement" and kind == "nonlinear" and "until" in t and until_probe is None:
         r.fail("analysis.control", "displacement control needs until = { probe, value }: "
                "the probe is the controlled displacement")
-    max_steps = r.integer(t, "max_steps", key, default=200, lo=1, hi=100_000)
+    d = Analysis()
+    max_steps = r.integer(t, "max_steps", key, default=d.max_steps, lo=1, hi=100_000)
     inc = r.number(t, "initial_increment", key, default=None, positive=True)
     lo = r.number(t, "min_increment", key, default=None, positive=True)
     hi = r.number(t, "max_increment", key, default=None, positive=True)
     if lo is not None and hi is not None and lo > hi:
         r.fail("analysis.min_increment", f"{lo:g} is larger than max_increment {hi:g}")
-    tol = r.number(t, "tol", key, default=1e-8, positive=True)
+    tol = r.number(t, "tol", key, default=d.tol, positive=True)
     if tol is not None and tol >= 1e-2:
         r.fail("analysis.tol", f"{tol:g} is too loose for equilibrium (use < 1e-2)")
-    max_it = r.integer(t, "max_iterations", key, default=25, lo=1, hi=1000)
-    return Analysis(kind=kind or "nonlinear", control=control or "load", until_probe=until_probe,
+    max_it = r.integer(t, "max_iterations", key, default=d.max_iterations, lo=1, hi=1000)
+    return Analysis(kind=kind or d.kind, control=control or d.control, until_probe=until_probe,
                     until_value=until_value, until_load_factor=until_lf,
-                    max_steps=max_steps or 200, initial_increment=inc, min_increment=lo,
-                    max_increment=hi, tol=tol or 1e-8, max_iterations=max_it or 25)
+                    max_steps=max_steps or d.max_steps, initial_increment=inc, min_increment=lo,
+                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations)
 
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
@@ -407,9 +425,9 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     d = BeamModelOptions()
     return BeamModelOptions(
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
-        grading=r.choice(t, "grading", key, ("graded", "tips", "uniform"), default=d.grading)
+        grading=r.choice(t, "grading", key, GRADINGS, default=d.grading)
         or d.grading,
-        face_membrane=r.choice(t, "face_membrane", key, ("paper", "averaged"),
+        face_membrane=r.choice(t, "face_membrane", key, FACE_MEMBRANES,
                                default=d.face_membrane) or d.face_membrane,
         gauss_x=r.integer(t, "gauss_x", key, default=None, lo=2, hi=12),
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
@@ -425,7 +443,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
     if t is None:
         return Reference2DOptions()
     d = Reference2DOptions()
-    level = r.choice(t, "level", key, ("coarse", "medium", "fine", "explicit"), default=d.level)
+    level = r.choice(t, "level", key, MESH_LEVELS, default=d.level)
     sizes = {k: r.number(t, k, key, default=None, positive=True)
              for k in ("core_size", "face_size", "tip_size")}
     if level == "explicit" and sizes["core_size"] is None:
@@ -436,7 +454,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
         half = False
     return Reference2DOptions(
         level=level or d.level,
-        refine=r.integer(t, "refine", key, default=0, lo=0, hi=6) or 0,
+        refine=r.integer(t, "refine", key, default=d.refine, lo=0, hi=6) or 0,
         face_elements=r.integer(t, "face_elements", key, default=d.face_elements, lo=1, hi=16)
         or d.face_elements,
         half_model=half,

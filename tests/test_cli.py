@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from sandwich.cli import main
+from sandwich_cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 

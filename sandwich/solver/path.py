@@ -122,6 +122,17 @@ class PathOptions:
     target_tol: float = 1e-6
     target_accept: float = 1e-3
 
+    @classmethod
+    def from_analysis(cls, analysis: object, **overrides: object) -> PathOptions:
+        """The options of a scene's ``[analysis]`` (:class:`sandwich.scene.Analysis`).
+
+        ``overrides`` are a model's own settings on top (e.g. a Newton tolerance floor, an
+        increment floor, ``desired_iterations``); ``None`` values among them are kept.
+        """
+        names = ("control", "until_load_factor", "until_probe", "until_value", "max_steps",
+                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations")
+        return cls(**{**{n: getattr(analysis, n) for n in names}, **overrides})
+
     def __post_init__(self) -> None:
         if self.control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}, got {self.control!r}")
