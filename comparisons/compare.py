@@ -21,7 +21,8 @@ from comparisons.plots import Panel, overlay
 from comparisons.profiles import ChosenProfile, choose_common
 from models import ModelRun, Progress, Solver, obtain
 from sandwich.results import Solution, atomic_write_text
-from sandwich.scene import Scene, load_scene
+from sandwich.scene import Scene
+from sandwich.scene_file import load_scene
 
 
 @dataclass

@@ -14,7 +14,8 @@ from comparisons.claims import ClaimResult, check_claims
 from comparisons.compare import Comparison, compare
 from models import PROJECT_ROOT, Progress, Solver
 from sandwich.results import atomic_write_text
-from sandwich.scene import Scene, load_scene
+from sandwich.scene import Scene
+from sandwich.scene_file import load_scene
 
 
 @dataclass

@@ -22,7 +22,8 @@ from pathlib import Path
 
 from models import MODELS, PROJECT_ROOT, ModelRun, mpi_rank, run_model, with_options
 from sandwich.results import OutputError, check_output_folder
-from sandwich.scene import MESH_LEVELS, Scene, SceneError, load_scene
+from sandwich.scene import MESH_LEVELS, Scene, SceneError
+from sandwich.scene_file import load_scene
 
 EXIT_OK, EXIT_STOPPED, EXIT_BAD_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
 RESULTS = Path("results")

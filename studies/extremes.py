@@ -56,7 +56,8 @@ import numpy as np  # noqa: E402
 from comparisons.paths import LOAD, curve_error, path_curve, path_parameter  # noqa: E402
 from models import get_model, with_options  # noqa: E402
 from sandwich.results import Solution, StepRecord  # noqa: E402
-from sandwich.scene import Debond, Layer, Load, Probe, Scene, Support, load_scene  # noqa: E402
+from sandwich.scene import Debond, Layer, Load, Probe, Scene, Support  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]  # the project: scenes/, benchmarks/results/
 OUT = ROOT / "benchmarks" / "results" / "comparisons"

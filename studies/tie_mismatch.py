@@ -43,17 +43,8 @@ import numpy as np
 from beam_element import run
 from beam_element.dofs import DOF_NAMES
 from beam_element.fields import sample_layer
-from sandwich.scene import (
-    Analysis,
-    BeamModelOptions,
-    Layer,
-    Load,
-    Material,
-    Probe,
-    Scene,
-    Support,
-    load_scene,
-)
+from sandwich.scene import Analysis, BeamModelOptions, Layer, Load, Material, Probe, Scene, Support
+from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]  # the project: scenes/, benchmarks/results/
 OUT = ROOT / "benchmarks" / "results" / "beam"

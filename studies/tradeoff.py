@@ -42,7 +42,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from models import MODELS, with_options  # noqa: E402
 from sandwich.results import Solution  # noqa: E402
-from sandwich.scene import Scene, load_scene  # noqa: E402
+from sandwich.scene import Scene  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]  # the project: scenes/, benchmarks/results/
 OUT = ROOT / "benchmarks" / "results" / "comparisons"

@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 
 from beam_element import run
-from sandwich.scene import Analysis, load_scene
+from sandwich.scene import Analysis
+from sandwich.scene_file import load_scene
 from studies import tie_mismatch
 
 ROOT = Path(__file__).resolve().parents[2]

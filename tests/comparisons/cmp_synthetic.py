@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from sandwich.results import LimitPoint, Profile, Solution, StepRecord
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 K, C = 10.0, 0.02  # N/mm, N/mm³

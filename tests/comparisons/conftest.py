@@ -21,7 +21,7 @@ from cmp_synthetic import (
     scene_copy,
 )
 
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ import json
 import pytest
 
 from models import obtain, registry, stored_identity
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 from sandwich_cli import main
 
 

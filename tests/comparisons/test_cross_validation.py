@@ -30,7 +30,7 @@ import pytest
 from comparisons import compare
 from comparisons.profiles import window_average
 from models import MODELS
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
 

@@ -45,17 +45,8 @@ import numpy as np
 import pytest
 
 from beam_element import run
-from sandwich.scene import (
-    Analysis,
-    BeamModelOptions,
-    Layer,
-    Load,
-    Material,
-    Probe,
-    Scene,
-    Support,
-    load_scene,
-)
+from sandwich.scene import Analysis, BeamModelOptions, Layer, Load, Material, Probe, Scene, Support
+from sandwich.scene_file import load_scene
 from studies import extremes
 
 ROOT = Path(__file__).resolve().parents[2]
