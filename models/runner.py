@@ -156,13 +156,25 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
         partial = _partial(model, scene, streamed, time.perf_counter() - t0)
         partial.extra[IDENTITY_KEY] = {**identity.to_dict(), "complete": False}
         if mpi_rank() == 0:
-            write_solution(partial, folder)
+            _write(partial, folder)
         say(ProgressEvent(model, "interrupted", step=len(streamed), message=partial.message))
         raise
     solution.extra[IDENTITY_KEY] = identity.to_dict()
     if mpi_rank() == 0:
-        write_solution(solution, folder)
+        _write(solution, folder)
     return solution
+
+
+def _write(solution: Solution, folder: Path) -> None:
+    """Write the result set; a failing write (a full disk) is an :class:`OutputError`."""
+    try:
+        write_solution(solution, folder)
+    except OutputError:
+        raise
+    except OSError as exc:
+        raise OutputError(f"{folder}: the result set could not be written "
+                          f"({exc.strerror or exc}); a previous result there is unchanged"
+                          ) from exc
 
 
 def obtain(scene: Scene, model: str, folder: Path, *, reuse: bool = True,

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import glob
+import logging
 import signal
 import sys
 import tempfile
@@ -26,6 +27,21 @@ from sandwich.scene import MESH_LEVELS, Scene, SceneError
 from sandwich.scene_file import load_scene
 
 EXIT_OK, EXIT_STOPPED, EXIT_BAD_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
+EXAMPLES = """units: N, mm, MPa (scene files); load factor λ multiplies every load's force
+
+examples:
+  sandwich validate scenes/*.toml
+  sandwich solve scenes/paper-fig5-top-debond-40-load-top.toml --model beam --elements 480
+  sandwich solve scenes/paper-fig5-top-debond-40-load-top.toml --model 2d --level coarse
+  sandwich compare scenes/default.toml --out /tmp/cmp
+  sandwich gallery --out /tmp/gallery
+
+exit codes: 0 done, 1 stopped before the target or interrupted (converged steps written),
+2 bad input (scene, option or output folder; nothing solved), 3 internal error (crash log named)
+"""
+# Loggers of the FEniCSx stack: their warnings and the JIT compiler's INFO lines are shown only
+# with --verbose (the 2D model's first run compiles its forms)
+QUIET_LOGGERS = ("UFL", "FFCx", "ffcx", "dolfinx", "py.warnings")
 RESULTS = Path("results")
 REFINE_RANGE = (0, 6)  # as the scene's [reference2d] refine
 ELEMENTS_RANGE = (2, 200_000)  # as the scene's [beam_model] elements
@@ -224,16 +240,30 @@ def cmd_demo(args: argparse.Namespace) -> int:
 DEMO_SCENE = "scenes/default.toml"
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return f"sandwich {version('sandwich-debond')}"
+    except PackageNotFoundError:
+        return "sandwich (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``sandwich`` command."""
-    p = argparse.ArgumentParser(prog="sandwich", description=__doc__.splitlines()[0],
-                                epilog="exit codes: 0 done, 1 stopped before the target "
-                                       "(converged steps written), 2 bad input, 3 internal "
-                                       "error")
+    p = argparse.ArgumentParser(
+        prog="sandwich", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Sandwich beams with face/core debonds: the paper's beam element and a 2D "
+                    "plane-stress reference on one scene file.", epilog=EXAMPLES)
+    p.add_argument("--version", action="version", version=_version())
     p.add_argument("--quiet", action="store_true", help="print only errors, no progress bar")
+    p.add_argument("--verbose", action="store_true",
+                   help="also show the FEniCSx stack's warnings and compiler logs")
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
                         help="print only errors, no progress bar")
+    common.add_argument("--verbose", action="store_true", default=argparse.SUPPRESS,
+                        help="also show the FEniCSx stack's warnings and compiler logs")
     sub = p.add_subparsers(dest="command", required=True)
 
     v = sub.add_parser("validate", parents=[common], help="check scene files")
@@ -244,20 +274,23 @@ def build_parser() -> argparse.ArgumentParser:
                        help="mesh a scene for the 2D reference (.msh, .xdmf)")
     m.add_argument("scene", help="scene file (TOML)")
     m.add_argument("--level", choices=MESH_LEVELS, help="2D mesh level (overrides the scene)")
-    m.add_argument("--refine", type=int,
+    m.add_argument("--refine", type=int, metavar="N",
                    help="uniform halvings of every element size, 0-6 (overrides the scene)")
     m.add_argument("--out", help="folder of the mesh files (default results/<scene>/mesh/)")
     m.set_defaults(func=cmd_mesh)
 
     s = sub.add_parser("solve", parents=[common], help="solve a scene with one model")
     s.add_argument("scene", help="scene file (TOML)")
-    s.add_argument("--model", choices=tuple(MODELS), required=True)
+    s.add_argument("--model", choices=tuple(MODELS), required=True,
+                   help="beam: the paper's element; 2d: the plane-stress reference (FEniCSx)")
     s.add_argument("--out", help="result folder (default results/<scene>/<model>/)")
     s.add_argument("--level", choices=MESH_LEVELS, help="2D mesh level (overrides the scene)")
-    s.add_argument("--refine", type=int,
-                   help="2D uniform refinements, 0-6 (overrides the scene)")
-    s.add_argument("--elements", type=int,
-                   help="beam element count (overrides the scene's [beam_model] elements)")
+    s.add_argument("--refine", type=int, metavar="N",
+                   help="2D uniform refinements, 0-6, each halves every element size "
+                        "(overrides the scene)")
+    s.add_argument("--elements", type=int, metavar="N",
+                   help="beam element count along the span, 2-200000 (overrides the scene's "
+                        "[beam_model] elements)")
     s.set_defaults(func=cmd_solve)
 
     c = sub.add_parser("compare", parents=[common],
@@ -278,9 +311,42 @@ def build_parser() -> argparse.ArgumentParser:
     g.set_defaults(func=cmd_gallery)
 
     d = sub.add_parser("demo", parents=[common], help="run the default scene end to end")
-    d.add_argument("scene", nargs="?", default=DEMO_SCENE)
+    d.add_argument("scene", nargs="?", default=DEMO_SCENE,
+                   help=f"scene file (default {DEMO_SCENE}, also from outside the checkout)")
     d.set_defaults(func=cmd_demo)
     return p
+
+
+class _Below(logging.Filter):
+    """Drops records below a level (a filter: the libraries reset their loggers' levels)."""
+
+    def __init__(self, level: int):
+        super().__init__()
+        self.level = level
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.levelno >= self.level
+
+
+def _hush_libraries() -> None:
+    """Keep the FEniCSx stack's log lines off the terminal (shown with ``--verbose``).
+
+    The JIT compiler logs "INFO:root:running build_ext ..." on the root logger (setuptools sets
+    its level to INFO), UFL warns about the DQ element on its own logger with its own handler:
+    filters on those loggers hold whatever levels the libraries set later.
+    """
+    _unhush_libraries()
+    logging.getLogger().addFilter(_Below(logging.WARNING))
+    for name in QUIET_LOGGERS:
+        logging.getLogger(name).addFilter(_Below(logging.ERROR))
+
+
+def _unhush_libraries() -> None:
+    """Remove the filters of :func:`_hush_libraries` (``main`` returns to a caller)."""
+    for name in ("", *QUIET_LOGGERS):
+        logger = logging.getLogger(name)
+        for f in [f for f in logger.filters if isinstance(f, _Below)]:
+            logger.removeFilter(f)
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -313,6 +379,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     parser = build_parser()
     args = parser.parse_args(argv)
+    if not getattr(args, "verbose", False):
+        _hush_libraries()
     try:
         previous = signal.signal(signal.SIGTERM, _interrupt)
     except ValueError:  # not the main thread (tests driving main in a thread)
@@ -335,5 +403,6 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return EXIT_INTERNAL
     finally:
+        _unhush_libraries()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -63,3 +63,45 @@ def test_bad_model_name_is_a_usage_error_not_a_traceback(capsys):
         main(["solve", str(ROOT / "scenes" / "default.toml"), "--model", "fem3d"])
     assert info.value.code == 2
     assert "invalid choice" in capsys.readouterr().err
+
+
+def test_progress_is_a_few_lines_when_not_a_terminal(tmp_path):
+    import io
+    from types import SimpleNamespace
+
+    from sandwich.progress import PathProgress
+    from sandwich.scene_file import load_scene
+
+    scene = load_scene(_small_scene(tmp_path))  # until w_top_mid = -1
+    log = io.StringIO()  # not a terminal
+    with PathProgress(scene, "small", stream=log) as bar:
+        for i in range(1, 101):
+            bar(SimpleNamespace(step=i, load_factor=float(i), probes={"w_top_mid": -i / 100}))
+    lines = log.getvalue().splitlines()
+    assert 10 <= len(lines) <= 11  # one per tenth of the way, not one per step
+    assert lines[-1].startswith("small: 100% step 100")
+    assert "\r" not in log.getvalue()
+
+
+def test_library_log_lines_are_held_back_unless_verbose():
+    import logging
+
+    from sandwich_cli.commands import _hush_libraries, _unhush_libraries
+
+    seen = []
+    handler = logging.Handler()
+    handler.emit = lambda record: seen.append(record.getMessage())
+    root = logging.getLogger()
+    root.addHandler(handler)
+    try:
+        _hush_libraries()
+        root.setLevel(logging.INFO)  # as setuptools does when the 2D forms are compiled
+        root.info("running build_ext")
+        logging.getLogger("UFL").warning("Discontinuous Lagrange element requested")
+        root.error("a real error")
+        _unhush_libraries()
+        root.info("shown again")
+    finally:
+        root.removeHandler(handler)
+        root.setLevel(logging.WARNING)
+    assert seen == ["a real error", "shown again"]

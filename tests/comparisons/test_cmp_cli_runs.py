@@ -114,3 +114,25 @@ def test_an_output_folder_that_is_a_file_is_refused_before_the_solve(
     code = main(["solve", str(scene_file), "--model", "beam", "--out", str(tmp_path / "f")])
     assert code == 2 and "not a folder" in capsys.readouterr().err
     assert fake_models == [] and (tmp_path / "f").read_text() == "x"
+
+
+def test_a_full_disk_keeps_the_previous_result_and_says_so(tmp_path, scene_file, fake_models,
+                                                           monkeypatch, capsys):
+    import errno
+
+    from sandwich.results import writing
+
+    out = tmp_path / "r"
+    assert main(["solve", str(scene_file), "--model", "beam", "--out", str(out), "--quiet"]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def full(path, text):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(writing, "_write_file", full)
+    code = main(["solve", str(scene_file), "--model", "beam", "--out", str(out), "--quiet",
+                 "--elements", "60"])
+    err = capsys.readouterr().err
+    assert code == 2 and "No space left on device" in err and "Traceback" not in err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r", "scene.toml"]
