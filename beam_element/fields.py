@@ -41,17 +41,30 @@ def sample_layer(
     model: BeamModel, layer: str, u_full: np.ndarray, eta: np.ndarray, xi: np.ndarray,
     nonlinear: bool = True,
 ) -> LayerSample:
-    """Displacements and stresses of ``layer`` at points (η, ξ) of every element."""
-    op = model.layers[layer].at(np.asarray(eta, float), np.asarray(xi, float))
-    lengths = model.mesh.lengths
-    u_ref = u_full[model.element_dofs][:, op.dofs] * op.x_slope_scale(lengths)
-    g = gradients(op, u_ref, lengths)
-    ε = np.stack(green_lagrange(g) if nonlinear else linear_strains(g), axis=-1)
-    σ = ε @ op.stiffness.T  # eq. (3)
-    x = model.mesh.x[:-1, None] + 0.5 * (op.eta[None, :] + 1) * lengths[:, None]
-    z = np.broadcast_to(op.z_bottom + 0.5 * (op.xi + 1) * op.thickness, x.shape)
-    return LayerSample(x=x, z=np.array(z), u=u_ref @ op.N.T, w=u_ref @ op.M.T,
-                       sigma_x=σ[..., 0], sigma_z=σ[..., 1], tau=σ[..., 2])
+    """Displacements and stresses of ``layer`` at points (η, ξ) of every element.
+
+    The core is sampled group by group (its level may change along x, :class:`CoreGroup`).
+    """
+    eta, xi = np.asarray(eta, float), np.asarray(xi, float)
+    if layer == "core":
+        families = [(g.op, g.elements, g.dofs) for g in model.core]
+    else:
+        families = [(model.layers[layer], np.arange(model.mesh.n_elements),
+                     model.element_dofs[:, model.layers[layer].dofs])]
+    E, G = model.mesh.n_elements, eta.size
+    out = {k: np.empty((E, G)) for k in ("x", "z", "u", "w", "sigma_x", "sigma_z", "tau")}
+    for rows, els, dofs in families:
+        op = rows.at(eta, xi)
+        lengths = model.mesh.lengths[els]
+        u_ref = u_full[dofs] * op.x_slope_scale(lengths)
+        g = gradients(op, u_ref, lengths)
+        ε = np.stack(green_lagrange(g) if nonlinear else linear_strains(g), axis=-1)
+        σ = ε @ op.stiffness.T  # eq. (3)
+        out["x"][els] = model.mesh.x[els, None] + 0.5 * (op.eta[None, :] + 1) * lengths[:, None]
+        out["z"][els] = (op.z_bottom + 0.5 * (op.xi + 1) * op.thickness)[None, :]
+        out["u"][els], out["w"][els] = u_ref @ op.N.T, u_ref @ op.M.T
+        out["sigma_x"][els], out["sigma_z"][els], out["tau"][els] = σ[..., 0], σ[..., 1], σ[..., 2]
+    return LayerSample(**out)
 
 
 def _stations(per_element: int) -> np.ndarray:

@@ -41,9 +41,10 @@ Solver = Callable[..., Solution]
 class ProgressEvent:
     """What the runner is doing: which model, which phase, which step.
 
-    ``phase`` is ``"start"``, ``"step"`` (a converged step), ``"done"``, ``"reused"``,
-    ``"stale"`` (a result folder exists but is not reused; ``message`` says why),
-    ``"missing"``, ``"failed"`` or ``"interrupted"``.
+    ``phase`` is ``"start"``, ``"step"`` (a converged step), ``"note"`` (what a model says
+    while solving, e.g. that it reruns the path), ``"done"``, ``"reused"``, ``"stale"`` (a
+    result folder exists but is not reused; ``message`` says why), ``"missing"``, ``"failed"``
+    or ``"interrupted"``.
     """
 
     model: str
@@ -142,6 +143,11 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
 
     def on_state(state: object) -> None:
         if isinstance(state, dict):  # information from a solver, not a path state
+            return
+        if getattr(state, "probes", None) is None:  # a note, e.g. the path is rerun
+            note = str(getattr(state, "message", ""))
+            streamed.clear()  # a rerun starts the path again: its states supersede these
+            say(ProgressEvent(model, "note", message=note))
             return
         rec = StepRecord(int(state.step), float(state.load_factor),  # type: ignore[attr-defined]
                          dict(state.probes), int(getattr(state, "iterations", 0)))  # type: ignore[attr-defined]

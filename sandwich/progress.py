@@ -56,6 +56,13 @@ class PathProgress:
     def __call__(self, state: Any) -> None:
         """Per-step callback: ``state`` has ``step``, ``load_factor`` and ``probes``."""
         self.last_step = int(getattr(state, "step", self.last_step + 1))
+        note = getattr(state, "message", None)  # an event that is not a step (e.g. a rerun)
+        if isinstance(note, str) and note:
+            if self.bar is not None:
+                self.bar.write(f"{self.label}: {note}")
+            elif self.lines:
+                print(f"{self.label}: {note}", file=self.stream, flush=True)
+                self._last_line = (-1, 0.0)  # the path restarts: so do the lines
         lam = float(getattr(state, "load_factor", 0.0))
         probes = dict(getattr(state, "probes", {}) or {})
         if self.lines:

@@ -23,6 +23,8 @@ FACE_MEMBRANES = ("paper", "averaged")  # [beam_model] face_membrane
 MESH_LEVELS = ("coarse", "medium", "fine", "explicit")  # [reference2d] level: the 2D mesh
 # Scene and probe names become folder and file names (results/<scene>/, load_<probe>.png)
 NAME_PATTERN = r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}"
+CORE_BASES = ("sublayers", "polynomial")  # enrichment families of the beam's core levels
+MAX_CORE_LEVEL = 6
 
 
 @dataclass(frozen=True)
@@ -169,6 +171,20 @@ class BeamModelOptions:
     gauss_z: int | None = None
     contact_penalty: float | None = None
     profile_every: int = 0  # 0: profiles at the last step only
+    core: int | str = "auto"  # core level 1 (the paper's) .. MAX_CORE_LEVEL, or "auto"
+    core_basis: str = "sublayers"  # "sublayers" (graded C1 cubic sublayers) | "polynomial"
+    tolerance: float = 0.01  # "auto": target relative error of the core's through-thickness field
+    max_core_level: int = 4  # "auto": highest level it may choose
+    core_zones: tuple[CoreZone, ...] = ()  # explicit levels over stretches of x
+
+
+@dataclass(frozen=True)
+class CoreZone:
+    """A stretch [start, end] of x (mm) where the beam's core has at least ``level``."""
+
+    start: float
+    end: float
+    level: int
 
 
 @dataclass(frozen=True)

@@ -14,16 +14,19 @@ from typing import Any
 from sandwich.scene import (
     ANALYSIS_KINDS,
     CONTROLS,
+    CORE_BASES,
     FACE_MEMBRANES,
     FACES,
     GRADINGS,
     INTERFACES,
+    MAX_CORE_LEVEL,
     MESH_LEVELS,
     NAME_PATTERN,
     SUPPORT_SITES,
     SUPPORT_TYPES,
     Analysis,
     BeamModelOptions,
+    CoreZone,
     Debond,
     Layer,
     Load,
@@ -419,11 +422,44 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     key = "beam_model"
     t = r.table(tbl, key, ("elements", "grading", "face_membrane", "gauss_x", "gauss_z",
-                           "contact_penalty", "profile_every"))
+                           "contact_penalty", "profile_every", "core", "core_basis", "tolerance",
+                           "max_core_level", "core_zones"))
     if t is None:
         return BeamModelOptions()
     d = BeamModelOptions()
+    core: Any = d.core
+    if "core" in t:
+        core = t["core"]
+        if core != "auto" and (isinstance(core, bool) or not isinstance(core, int)
+                               or not 1 <= core <= MAX_CORE_LEVEL):
+            r.fail("beam_model.core", f"expected \"auto\" or a core level 1..{MAX_CORE_LEVEL}, "
+                   f"got {core!r}")
+            core = d.core
+    tolerance = r.number(t, "tolerance", key, default=d.tolerance, positive=True)
+    if tolerance is not None and not 1e-6 <= tolerance <= 0.5:
+        r.fail("beam_model.tolerance", f"must be between 1e-6 and 0.5 (a relative error), "
+               f"got {tolerance:g}")
+        tolerance = None
+    zones = []
+    for i, z in enumerate(r.array_of_tables(t.get("core_zones", []), "beam_model.core_zones")):
+        zkey = f"beam_model.core_zones.{i}"
+        zt = r.table(z, zkey, ("start", "end", "level"), required=("start", "end", "level"))
+        if zt is None:
+            continue
+        a, b = r.number(zt, "start", zkey), r.number(zt, "end", zkey)
+        level = r.integer(zt, "level", zkey, lo=1, hi=MAX_CORE_LEVEL)
+        if a is not None and b is not None and b <= a:
+            r.fail(f"{zkey}.end", f"must be greater than start ({b:g} <= {a:g})")
+        elif None not in (a, b, level):
+            zones.append(CoreZone(start=a, end=b, level=level))
     return BeamModelOptions(
+        core=core,
+        core_basis=r.choice(t, "core_basis", key, CORE_BASES, default=d.core_basis)
+        or d.core_basis,
+        tolerance=tolerance or d.tolerance,
+        max_core_level=r.integer(t, "max_core_level", key, default=d.max_core_level, lo=1,
+                                 hi=MAX_CORE_LEVEL) or d.max_core_level,
+        core_zones=tuple(zones),
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
         grading=r.choice(t, "grading", key, GRADINGS, default=d.grading)
         or d.grading,

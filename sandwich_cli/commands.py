@@ -20,6 +20,7 @@ import tempfile
 import time
 import traceback
 from pathlib import Path
+from types import SimpleNamespace
 
 from models import MODELS, PROJECT_ROOT, ModelRun, mpi_rank, run_model, with_options
 from sandwich.results import OutputError, check_output_folder
@@ -130,6 +131,8 @@ class _StepBar:
     def __call__(self, event) -> None:
         if event.phase == "step":
             self.bar(event)
+        elif event.phase == "note":  # the bar restarts with the path
+            self.bar(SimpleNamespace(step=0, load_factor=0.0, probes={}, message=event.message))
 
 
 def cmd_solve(args: argparse.Namespace) -> int:

@@ -183,7 +183,8 @@ def _label(r: dict[str, object], model: str) -> str:
 def _child(solve: Callable, scene: Scene, conn) -> None:  # pragma: no cover - runs in a fork
     try:
         sol = solve(scene, progress=lambda st: conn.send(
-            ("info", st) if isinstance(st, dict) else ("state", _state_tuple(st))))
+            ("info", st) if isinstance(st, dict) else ("note", str(getattr(st, "message", "")))
+            if getattr(st, "probes", None) is None else ("state", _state_tuple(st))))
         conn.send(("done", _light(sol)))
     except Skipped as exc:
         conn.send(("skipped", str(exc)))
@@ -227,6 +228,8 @@ def run_models(scene: Scene, solvers: dict[str, Callable], timeout: float | None
                         kind, payload = rd.recv()
                         if kind == "state":
                             states.append(payload)
+                        elif kind == "note":  # the model reruns the path from its start
+                            states.clear()
                         elif kind == "info":
                             info.update(payload)
                         else:
@@ -279,6 +282,7 @@ def _run_inline(model: str, scene: Scene, solve: Callable) -> Outcome:
     t0 = time.perf_counter()
     try:
         sol = solve(scene, progress=lambda st: info.update(st) if isinstance(st, dict)
+                    else states.clear() if getattr(st, "probes", None) is None
                     else states.append(_state_tuple(st)))
     except Skipped as exc:
         return Outcome(model, "skipped", None, str(exc), time.perf_counter() - t0, 0, info)

@@ -136,3 +136,27 @@ def test_a_full_disk_keeps_the_previous_result_and_says_so(tmp_path, scene_file,
     assert code == 2 and "No space left on device" in err and "Traceback" not in err
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r", "scene.toml"]
+
+
+def test_a_models_note_restarts_the_streamed_path(tmp_path, scene_file, synth, monkeypatch,
+                                                  capsys):
+    from types import SimpleNamespace
+
+    history = synth.make_solution("2d", n_steps=8).history
+
+    def rerun_then_interrupted(scene, progress=None):
+        for rec in history[:3]:
+            progress(rec)
+        progress(SimpleNamespace(step=0, load_factor=0.0, message="rerunning the path"))
+        for rec in history[:2]:
+            progress(rec)
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(registry.MODELS, "beam",
+                        dataclasses.replace(registry.MODELS["beam"], solve=rerun_then_interrupted))
+    out = tmp_path / "r"
+    assert main(["solve", str(scene_file), "--model", "beam", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "rerunning the path" in err and "Traceback" not in err
+    with open(out / "history.csv") as fh:
+        assert [int(r["step"]) for r in csv.DictReader(fh)] == [1, 2]  # the rerun's states only
