@@ -43,6 +43,10 @@ from sandwich.scene import (
 TOP_KEYS = ("name", "description", "beam", "layers", "materials", "debonds", "supports", "loads",
             "analysis", "probes", "beam_model", "reference2d")
 GEOMETRY_TOL = 1e-9  # mm: two stations closer than this are the same station
+MAX_MAGNITUDE = 1e12  # any number of a scene (N, mm, MPa): beyond it sizes overflow the meshers
+MIN_SIZE = 1e-6  # mm: the smallest length, width or thickness (1 nm)
+MIN_STIFFNESS_DET = 1e-6  # 1 - (Ex/Ez) nu_zx^2 below this: a nearly singular material
+MIN_TOL = 1e-14  # the Newton tolerance cannot go below round-off
 _MISSING = object()
 
 
@@ -86,6 +90,10 @@ class Reader:
                       else f"expected a number, got {_typename(v)}")
             return None
         v = float(v)
+        if abs(v) > MAX_MAGNITUDE:
+            self.fail(full, f"{v:g} is beyond any physical scale of this tool (|value| <= "
+                      f"{MAX_MAGNITUDE:g} in N, mm, MPa)")
+            return None
         if positive and v <= 0:
             self.fail(full, f"must be positive, got {v:g}")
             return None
@@ -202,8 +210,16 @@ def _beam(r: Reader, tbl: Any) -> tuple[float, float]:
     t = r.table(tbl, "beam", ("length", "width"), required=("length", "width"))
     if t is None:
         return 0.0, 0.0
-    return (r.number(t, "length", "beam", positive=True) or 0.0,
-            r.number(t, "width", "beam", positive=True) or 0.0)
+    return (_size(r, t, "length", "beam") or 0.0, _size(r, t, "width", "beam") or 0.0)
+
+
+def _size(r: Reader, t: dict[str, Any], k: str, key: str) -> float | None:
+    """A positive length (mm) no smaller than ``MIN_SIZE``."""
+    v = r.number(t, k, key, positive=True)
+    if v is not None and v < MIN_SIZE:
+        r.fail(_join(key, k), f"{v:g} mm is below the smallest size {MIN_SIZE:g} mm")
+        return None
+    return v
 
 
 def _materials(r: Reader, tbl: Any) -> dict[str, Material]:
@@ -226,6 +242,10 @@ def _materials(r: Reader, tbl: Any) -> dict[str, Material]:
                 r.fail(f"{key}.nu", f"{nu:g} makes the plane-stress stiffness not positive "
                        "definite (need -1 < nu < 1)")
                 nu = None
+            elif nu is not None and 1.0 - nu**2 < MIN_STIFFNESS_DET:
+                r.fail(f"{key}.nu", f"{nu:g} makes the plane-stress stiffness nearly singular "
+                       f"(1 - nu^2 = {1 - nu**2:.3g} < {MIN_STIFFNESS_DET:g})")
+                nu = None
             if E is not None and nu is not None:
                 out[mname] = Material(mname, "isotropic", E, E, E / (2 * (1 + nu)), nu)
         else:
@@ -240,6 +260,10 @@ def _materials(r: Reader, tbl: Any) -> dict[str, Material]:
             if 1.0 - (Ex / Ez) * nu**2 <= 0.0:
                 r.fail(f"{key}.nu_zx", f"1 - (Ex/Ez) nu_zx^2 = {1 - Ex / Ez * nu**2:.3g} <= 0: "
                        "the plane-stress stiffness is not positive definite")
+                continue
+            if 1.0 - (Ex / Ez) * nu**2 < MIN_STIFFNESS_DET:
+                r.fail(f"{key}.nu_zx", f"1 - (Ex/Ez) nu_zx^2 = {1 - Ex / Ez * nu**2:.3g} < "
+                       f"{MIN_STIFFNESS_DET:g}: the plane-stress stiffness is nearly singular")
                 continue
             out[mname] = Material(mname, "orthotropic", Ex, Ez, G, nu)
     return out
@@ -258,7 +282,7 @@ def _layers(r: Reader, tbl: Any, materials: dict[str, Material]) -> dict[str, La
         lt = r.table(t[lname], key, ("thickness", "material"), required=("thickness", "material"))
         if lt is None:
             continue
-        h = r.number(lt, "thickness", key, positive=True)
+        h = _size(r, lt, "thickness", key)
         mname = r.string(lt, "material", key)
         mat = None
         if isinstance(mname, str):
@@ -412,6 +436,9 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     tol = r.number(t, "tol", key, default=d.tol, positive=True)
     if tol is not None and tol >= 1e-2:
         r.fail("analysis.tol", f"{tol:g} is too loose for equilibrium (use < 1e-2)")
+    elif tol is not None and tol < MIN_TOL:
+        r.fail("analysis.tol", f"{tol:g} is below round-off: Newton cannot reach it "
+               f"(use >= {MIN_TOL:g})")
     max_it = r.integer(t, "max_iterations", key, default=d.max_iterations, lo=1, hi=1000)
     return Analysis(kind=kind or d.kind, control=control or d.control, until_probe=until_probe,
                     until_value=until_value, until_load_factor=until_lf,

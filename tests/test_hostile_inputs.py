@@ -67,3 +67,18 @@ def test_deeply_nested_toml_is_refused_in_words(tmp_path, capsys):
     path.write_text(DEFAULT + "\nbomb = " + "[" * 100_000 + "]" * 100_000 + "\n")
     code, err = _validate(path, capsys)
     assert code == 2 and str(path) in err
+
+
+@pytest.mark.parametrize("old, new, key, words", [
+    ("length = 300.0", "length = 1e308", "beam.length", "beyond any physical scale"),
+    ("width = 60.0", "width = 1e-300", "beam.width", "below the smallest size"),
+    ("max_steps = 400", "max_steps = 400\ntol = 1e-300", "analysis.tol", "below round-off"),
+    ("nu = 0.3", "nu = 0.9999999", ".nu", "nearly singular"),
+    ("nu = 0.3", "nu = -0.9999999", ".nu", "nearly singular"),
+])
+def test_physically_meaningless_numbers_are_refused(tmp_path, capsys, old, new, key, words):
+    assert old in DEFAULT, old
+    path = tmp_path / "s.toml"
+    path.write_text(DEFAULT.replace(old, new, 1))
+    code, err = _validate(path, capsys)
+    assert code == 2 and key in err and words in err
