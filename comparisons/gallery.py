@@ -32,6 +32,11 @@ def shipped_scenes(root: Path = PROJECT_ROOT) -> list[Path]:
     return sorted((root / "scenes").glob("paper-*.toml"))
 
 
+def _cell(text: str) -> str:
+    """Text for a Markdown table cell: one line, no column separator."""
+    return " ".join(str(text).split()).replace("|", "/")
+
+
 def _pct(v: float | None) -> str:
     return "—" if v is None else f"{100 * v:.2f} %"
 
@@ -49,7 +54,7 @@ def scene_section(cmp: Comparison, report_dir: Path) -> list[str]:
     for name, s in m.models.items():
         lims = ", ".join(f"{ll.load_factor:.4g}" for ll in s.limit_loads) or "none"
         if s.origin in ("missing", "failed"):
-            lines.append(f"| {name} | {s.origin}: {s.reason} | — | — | — | — | — | — |")
+            lines.append(f"| {name} | {s.origin}: {_cell(s.reason)} | — | — | — | — | — | — |")
         else:
             lines.append(f"| {name} | {s.origin} | {s.converged} | {s.steps} | "
                          f"{_num(s.final_load_factor)} | {lims} | {_num(s.wall_seconds, '.3g')}"

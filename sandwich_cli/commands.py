@@ -135,6 +135,29 @@ class _StepBar:
             self.bar(SimpleNamespace(step=0, load_factor=0.0, probes={}, message=event.message))
 
 
+LARGE_BEAM = 20_000  # beam elements above which a solve takes minutes and gigabytes
+
+
+def warnings_before_solve(scene: Scene, model: str) -> list[str]:
+    """What a user should know before a solve starts (the solve still runs)."""
+    out = []
+    for i, ld in enumerate(scene.loads):
+        lo, hi = ld.span
+        for j, sup in enumerate(scene.supports):
+            if ld.on in sup.faces and lo - 1e-9 <= sup.x <= hi + 1e-9:
+                out.append(f"loads[{i}] acts over supports[{j}] (x = {sup.x:g} mm on the "
+                           f"{ld.on} face): the support takes the load through the core, which "
+                           "may crush there")
+    a = scene.analysis
+    if a.until_load_factor is not None and a.until_load_factor < 0:
+        out.append(f"analysis.until.load_factor = {a.until_load_factor:g} < 0 reverses every "
+                   "load's force")
+    if model == "beam" and scene.beam_model.elements > LARGE_BEAM:
+        out.append(f"beam_model.elements = {scene.beam_model.elements} is above {LARGE_BEAM}: "
+                   "expect minutes and gigabytes")
+    return out
+
+
 def cmd_solve(args: argparse.Namespace) -> int:
     """Solve one scene with one model."""
     from sandwich.progress import PathProgress
@@ -143,6 +166,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     scene = _overridden(scene, args.model, args)
     out = Path(args.out) if args.out else default_out(scene, args.model)
     check_output_folder(out)
+    for line in warnings_before_solve(scene, args.model):
+        print(f"warning: {scene.source}: {line}", file=sys.stderr)
     t0 = time.perf_counter()
     quiet = args.quiet or mpi_rank() != 0
     try:

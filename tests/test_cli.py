@@ -105,3 +105,19 @@ def test_library_log_lines_are_held_back_unless_verbose():
         root.removeHandler(handler)
         root.setLevel(logging.WARNING)
     assert seen == ["a real error", "shown again"]
+
+
+def test_warnings_before_a_solve(tmp_path):
+    import dataclasses
+
+    from sandwich.scene import Analysis, Load
+    from sandwich.scene_file import load_scene
+    from sandwich_cli.commands import warnings_before_solve
+
+    scene = load_scene(ROOT / "scenes" / "default.toml")
+    assert warnings_before_solve(scene, "beam") == []
+    pin = scene.supports[0]
+    over = dataclasses.replace(scene, loads=(Load(pin.faces[0], pin.x, 0.0, -1.0),),
+                               analysis=Analysis(kind="linear", until_load_factor=-2.0))
+    said = " / ".join(warnings_before_solve(over, "beam"))
+    assert "acts over supports[0]" in said and "reverses every load" in said
