@@ -351,7 +351,8 @@ def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> Fi
     """Faces and core of ``state`` on one quad grid (``section_fields``) as a ParaView frame.
 
     Point data: σ_x, σ_z, τ, von Mises (MPa, 2nd Piola-Kirchhoff); cell data: ``region``
-    (0 core, 1 top face, 2 bottom face). Points are reference (x, z), displacement (u, w) in mm.
+    (0 core, 1 top face, 2 bottom face) and ``core_level`` (0 on faces). Points are reference
+    (x, z), displacement (u, w) in mm.
     """
     f = section_fields(model, state.u, nonlinear=nonlinear)
     return FieldFrame(
@@ -359,7 +360,7 @@ def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> Fi
         displacement=f.displacement,
         point_data={"sigma_x": f.sigma_x, "sigma_z": f.sigma_z, "tau": f.tau,
                     "von_mises": f.von_mises},
-        cell_data={"region": f.region.astype(float)},
+        cell_data={"region": f.region.astype(float), "core_level": f.core_level.astype(float)},
     )
 
 

@@ -185,6 +185,10 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
     probes = _probes(r, data.get("probes", []), L)
     analysis = _analysis(r, data.get("analysis", {}), probes)
     beam_model = _beam_model(r, data.get("beam_model", {}))
+    for i, z in enumerate(beam_model.core_zones):
+        if L is not None and (z.start < 0 or z.end > L):
+            r.fail(f"beam_model.core_zones.{i}", f"[{z.start:g}, {z.end:g}] is not inside the "
+                   f"beam [0, {L:g}]")
     reference2d = _reference2d(r, data.get("reference2d", {}))
     if not r.problems:
         _check_mechanism(r, supports, debonds, length)

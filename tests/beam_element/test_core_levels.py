@@ -186,3 +186,21 @@ def test_linear_stiffness_converges_with_the_level():
     steps = -np.diff(k)
     assert np.all(steps > 0), k
     assert np.all(steps[1:] <= 0.5 * steps[:-1]), k
+
+
+def test_field_grid_shows_the_sublayers_and_their_levels():
+    from beam_element.fields import core_rows, section_fields
+
+    scene = _debonded_bend()
+    levels = np.array([1] * 4 + [3] * 4 + [2] * 4)
+    model = build_model(scene, elements=12, core_level=levels)
+    rows = core_rows(model, 9)
+    for cut in CoreBasis("sublayers", 3).partition(3):
+        assert np.any(np.isclose(rows, cut))
+    f = section_fields(model, np.zeros(model.size), per_element=2)
+    core_cells = f.region == 0
+    assert set(np.unique(f.core_level[core_cells])) == {1, 2, 3}
+    assert np.all(f.core_level[~core_cells] == 0)
+    # the cells of element 5 (level 3) carry level 3: columns 10, 11 of every core row
+    per_row = 12 * 2
+    assert np.all(f.core_level[:core_cells.sum()].reshape(-1, per_row)[:, 10:12] == 3)
