@@ -121,3 +121,28 @@ def test_warnings_before_a_solve(tmp_path):
                                analysis=Analysis(kind="linear", until_load_factor=-2.0))
     said = " / ".join(warnings_before_solve(over, "beam"))
     assert "acts over supports[0]" in said and "reverses every load" in said
+
+
+def test_an_internal_error_names_its_crash_log_and_leaves_the_current_folder_clean(
+        tmp_path, monkeypatch, capsys):
+    import re
+
+    from sandwich_cli import commands
+
+    def broken(args):
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(commands, "cmd_validate", broken)
+    work = tmp_path / "cwd"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    work.chmod(0o555)  # even a read-only current folder gets no crash log and no crash
+    try:
+        code = main(["validate", str(ROOT / "scenes" / "default.toml")])
+    finally:
+        work.chmod(0o755)
+    err = capsys.readouterr().err
+    assert code == 3 and "internal error (RuntimeError: a bug)" in err
+    log = re.search(r"details in (\S+)", err).group(1)
+    assert "Traceback" in Path(log).read_text() and list(work.iterdir()) == []
+    Path(log).unlink()
