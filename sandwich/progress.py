@@ -85,7 +85,7 @@ class PathProgress:
         if tenth <= shown and now - at < self.LINE_SECONDS:
             return
         self._last_line = (tenth, now)
-        pct = 100 * self.fraction(lam, probes)
+        pct = 100 * self.fraction(lam, probes) + 0.0  # no "-0%"
         print(f"{self.label}: {pct:3.0f}% step {self.last_step}, λ={lam:.4g}", file=self.stream,
               flush=True)
 

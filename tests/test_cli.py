@@ -2,6 +2,7 @@
 
 import csv
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -146,3 +147,37 @@ def test_an_internal_error_names_its_crash_log_and_leaves_the_current_folder_cle
     log = re.search(r"details in (\S+)", err).group(1)
     assert "Traceback" in Path(log).read_text() and list(work.iterdir()) == []
     Path(log).unlink()
+
+
+def test_ctrl_c_in_a_real_solve_keeps_the_converged_steps(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "r"
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "sandwich_cli", "solve", str(ROOT / "scenes" / "default.toml"),
+         "--model", "beam", "--out", str(out)],
+        cwd=tmp_path, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env)
+    lines = []
+    t0 = time.monotonic()
+    for line in proc.stderr:  # not a terminal: one progress line per tenth of the way
+        lines.append(line)
+        if "% step" in line and int(line.split("% step ")[1].split(",")[0]) >= 5:
+            break
+        assert time.monotonic() - t0 < 300, lines
+    proc.send_signal(signal.SIGINT)
+    rest = proc.stderr.read()
+    code = proc.wait(timeout=120)
+    if "reached" in rest and code == 0:  # the path finished before the signal landed
+        pytest.skip("the solve ended before the interrupt")
+    assert code == 1, rest
+    assert "interrupted" in rest and "Traceback" not in rest
+    with open(out / "history.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) >= 2 and float(rows[-1]["w_top_mid"]) < 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is False and "interrupted after step" in summary["message"]
+    assert list(tmp_path.iterdir()) == [out]
