@@ -28,6 +28,7 @@ from beam_element.fields import profile_columns, section_fields
 from beam_element.model import BeamModel, beam_mesh, build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
+from sandwich.scene import Scene
 
 MAX_ACTIVE_SET_PASSES = 50
 MIN_INCREMENT_PER_SMOOTHING = 0.01  # default path increment floor / contact smoothing width s
@@ -163,7 +164,7 @@ def _min_increment(model: BeamModel, analysis: object) -> float | None:
 
 
 def run(
-    scene: object,
+    scene: Scene,
     progress: Callable[[object], None] | None = None,
     *,
     elements: int | None = None,
@@ -342,7 +343,7 @@ def _max_penetration(model: BeamModel, states: list[ConvergedState]) -> float:
                default=0.0)
 
 
-def solve(scene: object, progress: Callable[[object], None] | None = None) -> Solution:
+def solve(scene: Scene, progress: Callable[[object], None] | None = None) -> Solution:
     """Solve ``scene`` with the beam element; see :func:`run`."""
     return run(scene, progress).solution
 
