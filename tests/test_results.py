@@ -3,6 +3,7 @@
 import csv
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -138,3 +139,9 @@ def test_an_output_path_that_is_a_file_is_refused_before_writing(tmp_path):
     with pytest.raises(OutputError):
         write_solution(_solution(), tmp_path / "f")
     assert (tmp_path / "f").read_text() == "x"
+
+
+def test_the_current_folder_as_output_is_written_in_place(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write_solution(_solution(), Path("."))
+    assert (tmp_path / "summary.json").is_file() and Path.cwd() == tmp_path

@@ -155,9 +155,10 @@ def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
     out_dir = Path(out_dir)
     files = result_texts(solution)
     check_output_folder(out_dir)
+    out_dir = Path(os.path.abspath(out_dir))
     foreign = out_dir.is_dir() and any(not is_result_file(f.name) and not f.name.startswith(".")
                                        for f in out_dir.iterdir())
-    if foreign:
+    if foreign or out_dir == Path(os.getcwd()):  # never swap away the folder we stand in
         for old in out_dir.iterdir():
             if is_result_file(old.name) and old.name not in files:
                 old.unlink()
