@@ -29,6 +29,7 @@ from beam_element.fields import profile_columns, section_fields
 from beam_element.model import BeamModel, beam_mesh, build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
+from sandwich.scene import Scene
 
 MAX_ACTIVE_SET_PASSES = 50
 MIN_INCREMENT_PER_SMOOTHING = 0.01  # default path increment floor / contact smoothing width s
@@ -165,7 +166,7 @@ def _min_increment(model: BeamModel, analysis: object) -> float | None:
 
 
 def run(
-    scene: object,
+    scene: Scene,
     progress: Callable[[object], None] | None = None,
     *,
     elements: int | None = None,
@@ -358,13 +359,8 @@ def _follow(
     from sandwich.solver.path import PathOptions, follow_path
 
     a = scene.analysis
-    options = PathOptions(
-        control=a.control, until_load_factor=a.until_load_factor, until_probe=a.until_probe,
-        until_value=a.until_value, max_steps=a.max_steps,
-        initial_increment=a.initial_increment, min_increment=_min_increment(model, a),
-        max_increment=a.max_increment, tol=a.tol, max_iterations=a.max_iterations,
-        desired_iterations=DESIRED_ITERATIONS,
-    )
+    options = PathOptions.from_analysis(a, min_increment=_min_increment(model, a),
+                                        desired_iterations=DESIRED_ITERATIONS)
     result = follow_path(model, options, list(model.probe_rows), progress)
     states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
               for s in result.states]
@@ -377,7 +373,7 @@ def _max_penetration(model: BeamModel, states: list[ConvergedState]) -> float:
                default=0.0)
 
 
-def solve(scene: object, progress: Callable[[object], None] | None = None) -> Solution:
+def solve(scene: Scene, progress: Callable[[object], None] | None = None) -> Solution:
     """Solve ``scene`` with the beam element; see :func:`run`."""
     return run(scene, progress).solution
 
