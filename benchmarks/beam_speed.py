@@ -36,7 +36,7 @@ sys.path.insert(0, str(ROOT))
 
 from beam_element import build_model, kernels, run  # noqa: E402
 from beam_element.model import BeamModel  # noqa: E402
-from sandwich.scene import load_scene  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 from sandwich.solver.envelope import EnvelopeFactorization  # noqa: E402
 from sandwich.solver.sparse import SparseFactorization  # noqa: E402
 

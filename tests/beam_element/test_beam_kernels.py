@@ -8,6 +8,7 @@ count n and point count G: a synthetic layer with extra DOFs and a non-tensor ru
 """
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -199,7 +200,7 @@ def test_beam_path_imports_no_2d_or_plotting_stack():
             "assert r.converged, r.reason\n"
             "print(sorted(k for k in ('dolfinx', 'gmsh', 'pyvista', 'matplotlib', 'petsc4py')"
             " if k in sys.modules))\n")
-    here = __import__("pathlib").Path(__file__).resolve().parent
+    here = Path(__file__).resolve().parent
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=300, cwd=here)
     assert out.returncode == 0, out.stderr
