@@ -237,11 +237,26 @@ def run(
             previous = last
             if progress is not None:
                 progress(CoreRecheck(level_counts(choice.levels)))
+        if choice.how == "auto" and not converged and np.any(choice.levels > 1):
+            # The path at the chosen levels stopped short: the paper's element is the fallback
+            # (extremes map: thin faces, L/h = 5 and load x2 reach their target only at level 1).
+            stopped = message
+            fallback = _follow_penalised(scene, elements, {**options, "core_level": 1}, progress)
+            if fallback[3]:
+                model, states, message, converged, limit_points, raised = fallback
+                choice.levels = np.ones_like(choice.levels)
+                choice.estimate = None
+                choice.passes.append({"stage": "fallback to level 1",
+                                      "elements_per_level": level_counts(choice.levels),
+                                      "load_factor": states[-1].load_factor, "reached": True,
+                                      "estimate": None})
+                message += (f"; WARNING: with auto core levels the path stopped ({stopped}); "
+                            "this is the paper's element (core level 1), its error not estimated")
         if raised:
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
-        if choice.how == "auto" and converged and (
+        if choice.how == "auto" and converged and np.any(choice.levels > 1) and (
                 choice.estimate is None or choice.estimate > float(bm.tolerance)):
             said = ("could not be estimated" if choice.estimate is None else
                     f"{100 * choice.estimate:.2g} % exceeds the tolerance "
