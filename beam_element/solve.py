@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from beam_element.contact import NORMAL_SIGN
 from beam_element.fields import profile_columns, section_fields
+from beam_element.fracture import beam_tips, history_columns, tip_releases
 from beam_element.model import BeamModel, build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
@@ -256,13 +257,15 @@ def _solution(
 ) -> Solution:
     history = []
     max_pen = max_slide = 0.0
+    tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
     for s in states:
         summary = model.contact_summary(s.u) if nonlinear else {}
         pen = max((c.max_penetration for c in summary.values()), default=0.0)
         slide = max((c.max_sliding for c in summary.values()), default=0.0)
         max_pen, max_slide = max(max_pen, pen), max(max_slide, slide)
         extra = {"max_penetration": pen, "max_sliding": slide,
-                 "contact_pairs_active": float(sum(c.active for c in summary.values()))}
+                 "contact_pairs_active": float(sum(c.active for c in summary.values())),
+                 **history_columns(tip_releases(model, s.u, tips))}
         history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
                                   iterations=s.iterations, extra=extra))
     every = int(getattr(getattr(scene, "beam_model", None), "profile_every", 0) or 0)
