@@ -200,8 +200,17 @@ def run(
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
+    solution.extra.update(_growth_summary(scene, solution))
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _growth_summary(scene: object, solution: Solution) -> dict[str, object]:
+    """Summary entry of the debond growth criterion (debonds with a toughness only)."""
+    from sandwich.fracture import growth_onset
+
+    onset = growth_onset(scene, solution.history)
+    return {"debond_growth": onset} if onset else {}
 
 
 def _follow(

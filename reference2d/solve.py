@@ -9,6 +9,7 @@ import numpy as np
 from reference2d.fracture import VcctEvaluator, history_columns
 from reference2d.model import Model2D, build_model
 from reference2d.profiles import ProfileSampler
+from sandwich.fracture import growth_onset
 from sandwich.results import Profile, Solution, StepRecord
 from sandwich.scene import Scene
 from sandwich.solver.path import PathOptions, PathState, follow_path, solve_linear
@@ -120,6 +121,9 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "mpi_ranks": int(model.disc.mesh.comm.size),
         "vcct_closure_length": float(vcct.closure_length),
     }
+    onset = growth_onset(scene, rows)  # debonds with a toughness: first step G >= G_c
+    if onset:
+        extra["debond_growth"] = onset
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)
