@@ -43,7 +43,8 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         Contact penalty (N/mm³) instead of the scene's or the default.
     closure_length
         VCCT closure length Δ (mm) of the energy release rate at the debond tips
-        (:mod:`reference2d.fracture`); default the thinner face's thickness.
+        (:mod:`reference2d.fracture`); default ``[reference2d] closure_length``, else the
+        thinner face's thickness.
     keep_states
         Keep the model and the displacement vector of every converged state on the returned
         solution (attribute ``reference2d_states``) for :func:`reference2d.write_fields`.
@@ -60,7 +61,8 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
                               root=0)
     model = build_model(scene, mesh, penalty=penalty)
     system = model.system
-    vcct = VcctEvaluator(model, closure_length)
+    vcct = VcctEvaluator(model, closure_length if closure_length is not None
+                         else scene.reference2d.closure_length)
     names = [p.name for p in scene.probes]
     a = scene.analysis
     rows: list[StepRecord] = []
@@ -120,6 +122,8 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "stress_measure": "second Piola-Kirchhoff, reference frame",
         "mpi_ranks": int(model.disc.mesh.comm.size),
         "vcct_closure_length": float(vcct.closure_length),
+        "vcct_closure_over_tip_element": (float(vcct.closure_over_element)
+                                          if vcct.tips else None),
     }
     onset = growth_onset(scene, rows)  # debonds with a toughness: first step G >= G_c
     if onset:

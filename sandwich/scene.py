@@ -193,6 +193,7 @@ class Reference2DOptions:
     half_model: bool = False
     contact_penalty: float | None = None
     profile_every: int = 0
+    closure_length: float | None = None  # VCCT closure length (mm); None: the thinner face
 
 
 @dataclass(frozen=True)

@@ -444,7 +444,8 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
 def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
     key = "reference2d"
     t = r.table(tbl, key, ("level", "refine", "face_elements", "core_size", "face_size",
-                           "tip_size", "half_model", "contact_penalty", "profile_every"))
+                           "tip_size", "half_model", "contact_penalty", "profile_every",
+                           "closure_length"))
     if t is None:
         return Reference2DOptions()
     d = Reference2DOptions()
@@ -465,6 +466,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
         half_model=half,
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
         profile_every=r.integer(t, "profile_every", key, default=0, lo=0) or 0,
+        closure_length=r.number(t, "closure_length", key, default=None, positive=True),
         **sizes,
     )
 
