@@ -51,6 +51,11 @@ def test_peel_couple_matches_closed_form_over_a_4x_range_of_closure_length():
     assert sol.history[-1].extra["G_0_end"] == pytest.approx(gs[0].G, rel=1e-10)
     assert sol.history[-1].extra["GI_0_end"] + sol.history[-1].extra["GII_0_end"] == \
         pytest.approx(gs[0].G, rel=1e-12)
+    # the domain J-integral, independent of the lips' forces and openings (disc of 8 mm)
+    from reference2d.jintegral import JIntegral
+
+    j = JIntegral(model, 60.0, 0.5 * sc.core.thickness, 1.0, 8.0).evaluate(state[2])
+    assert j == pytest.approx(exact, rel=0.02)
 
 
 def test_sliding_couples_are_mode_two_and_match_closed_form():
