@@ -2,7 +2,7 @@
 
 For each scene both models follow the scene's own path; each converged step's history holds
 ``G_<debond>_<tip>``, ``GI_…``, ``GII_…`` (N/mm). The table compares them at common values of the
-scene's until-probe (linear interpolation in each model's path, within the range both reached);
+scene's until-probe (interpolation of √G in each model's path, within the range both reached);
 the plot overlays G, G_I and G_II against that probe. The 2D model also reports the domain
 J-integral (``reference2d.jintegral``, disc of 4 face thicknesses) as a cross-check of its G.
 
@@ -66,6 +66,12 @@ def _path(sol, probe: str, tip: str) -> tuple[np.ndarray, ...]:
     return (w, np.array([r.load_factor for r in sol.history]), *cols)
 
 
+def _interp_energy(x: float, xs: np.ndarray, g: np.ndarray) -> float:
+    """Interpolate an energy release rate in √|G| (exact where G ∝ w², the linear regime)."""
+    r = np.interp(x, xs, np.sign(g) * np.sqrt(np.abs(g)))
+    return float(np.sign(r) * r * r)
+
+
 def _monotone(path: tuple[np.ndarray, ...], sign: float) -> tuple[np.ndarray, ...]:
     """The path up to where the probe first stops moving towards the target (a turn-back)."""
     w = sign * path[0]
@@ -122,7 +128,8 @@ def main() -> None:
             for w in sign * np.linspace(reach / SAMPLES, reach, SAMPLES):
                 row = []
                 for p in (pb, p2):
-                    row.append([np.interp(sign * w, sign * p[0], c) for c in p[1:]])
+                    row.append([np.interp(sign * w, sign * p[0], p[1]),
+                                *(_interp_energy(sign * w, sign * p[0], c) for c in p[2:])])
                 (lb, gb, _, giib, _), (l2, g2, _, gii2, j2) = row
                 ratio = f"{gb / g2:.3f}" if g2 > 0 else "-"
                 jr = f"{j2 / g2:.3f}" if g2 > 0 else "-"

@@ -31,12 +31,16 @@ T_FACE, H_CORE, WIDTH, LENGTH, D_COUPLE = 1.0, 10.0, 20.0, 200.0, 20.0
 
 
 def scene(loads, *, a=60.0, e_core=200.0, level="coarse", elements=240, until=0.1,
-          probe_on="top", tol=None):
+          probe_on="top", tol=None, mirror=False):
     """The debonded strip with ``loads`` (list of (face, x, force)), displacement-controlled.
 
     The path is driven by w of ``probe_on`` at x = 0 up to ``until`` mm (small: G is a linear
-    elasticity check; 0.1 mm is 0.1 % of a face rotation).
+    elasticity check; 0.1 mm is 0.1 % of a face rotation). ``mirror``: the same problem
+    reflected about mid-span (x -> L - x), whose tip is the debond's ``start``.
     """
+    def at(x):
+        return LENGTH - x if mirror else x
+
     analysis = {"kind": "nonlinear", "control": "displacement",
                 "until": {"probe": "w0", "value": until}}
     if tol is not None:
@@ -48,10 +52,11 @@ def scene(loads, *, a=60.0, e_core=200.0, level="coarse", elements=240, until=0.
                    "core": {"thickness": H_CORE, "material": "core"},
                    "bottom": {"thickness": T_FACE, "material": "face"}},
         "materials": {"face": {"E": E_FACE, "nu": NU}, "core": {"E": e_core, "nu": NU}},
-        "supports": [{"x": LENGTH, "on": "faces", "type": "clamp"}],
-        "loads": [{"on": f, "x": x, "width": 0.0, "force": p} for f, x, p in loads],
-        "debonds": [{"interface": "top", "start": 0.0, "end": a}],
-        "probes": [{"name": "w0", "on": probe_on, "x": 0.0}],
+        "supports": [{"x": at(LENGTH), "on": "faces", "type": "clamp"}],
+        "loads": [{"on": f, "x": at(x), "width": 0.0, "force": p} for f, x, p in loads],
+        "debonds": [{"interface": "top", "start": min(at(0.0), at(a)),
+                     "end": max(at(0.0), at(a))}],
+        "probes": [{"name": "w0", "on": probe_on, "x": at(0.0)}],
         "analysis": analysis,
         "reference2d": {"level": level},
         "beam_model": {"elements": elements},

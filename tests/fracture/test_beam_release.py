@@ -23,13 +23,25 @@ from beam_element.fracture import beam_tips, column_names, tip_releases
 from beam_element.solve import linear_solution, run
 
 
-def _release(sc):
+def _release(sc, tip="end"):
     r = run(sc)
     assert r.solution.converged, r.solution.message
     st = r.states[-1]
     tips = beam_tips(sc, r.model)
-    assert [(t.debond, t.tip) for t in tips] == [(0, "end")]  # x = 0 is an open mouth
+    assert [(t.debond, t.tip) for t in tips] == [(0, tip)]  # the other end is an open mouth
     return r, st, tip_releases(r.model, st.u, tips)[0]
+
+
+@pytest.mark.parametrize("case", ["peel", "sliding"])
+def test_start_tip_of_the_mirrored_problem_gives_the_same_g(case):
+    """x -> L - x: the tip is the debond's start; G and its split must not change."""
+    loads = peel_loads() if case == "peel" else shear_loads(scene(peel_loads()))
+    probe = "top" if case == "peel" else "bottom"
+    _, st, g = _release(scene(loads, probe_on=probe))
+    _, st_m, g_m = _release(scene(loads, probe_on=probe, mirror=True), tip="start")
+    assert st_m.load_factor == pytest.approx(st.load_factor, rel=1e-6)
+    for a, b in ((g.G, g_m.G), (g.GI, g_m.GI), (g.GII, g_m.GII)):
+        assert b == pytest.approx(a, rel=1e-4, abs=1e-4 * g.G)
 
 
 @pytest.mark.parametrize("elements", [120, 480])

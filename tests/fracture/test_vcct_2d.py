@@ -28,12 +28,22 @@ def _solve(sc, level="coarse"):
     return sol, model, states[-1]
 
 
-def _g(model, state, closure_length):
+def _g(model, state, closure_length, tip="end"):
     from reference2d.fracture import VcctEvaluator
 
     ev = VcctEvaluator(model, closure_length)
-    assert [(t.debond, t.tip) for t in ev.tips] == [(0, "end")]  # x = 0 is an open mouth
+    assert [(t.debond, t.tip) for t in ev.tips] == [(0, tip)]  # the other end: open mouth
     return ev.evaluate(state[2])[0]
+
+
+def test_start_tip_of_the_mirrored_problem_gives_the_same_g():
+    """x -> L - x (peel couple): the tip is the debond's start; G and split unchanged."""
+    _, model, state = _solve(scene(peel_loads()))
+    _, model_m, state_m = _solve(scene(peel_loads(), mirror=True))
+    g, g_m = _g(model, state, 2.0), _g(model_m, state_m, 2.0, tip="start")
+    assert state_m[1] == pytest.approx(state[1], rel=1e-3)
+    assert g_m.G == pytest.approx(g.G, rel=5e-3)
+    assert g_m.GI == pytest.approx(g.GI, rel=5e-3)
 
 
 def test_peel_couple_matches_closed_form_over_a_4x_range_of_closure_length():
