@@ -36,9 +36,16 @@ def _g(model, state, closure_length, tip="end"):
     return ev.evaluate(state[2])[0]
 
 
-def test_start_tip_of_the_mirrored_problem_gives_the_same_g():
+@pytest.fixture(scope="module")
+def peel():
+    """The peel couple at level coarse: scene, solution, model, last state."""
+    sc = scene(peel_loads())
+    return (sc, *_solve(sc))
+
+
+def test_start_tip_of_the_mirrored_problem_gives_the_same_g(peel):
     """x -> L - x (peel couple): the tip is the debond's start; G and split unchanged."""
-    _, model, state = _solve(scene(peel_loads()))
+    _, _, model, state = peel
     _, model_m, state_m = _solve(scene(peel_loads(), mirror=True))
     g, g_m = _g(model, state, 2.0), _g(model_m, state_m, 2.0, tip="start")
     assert state_m[1] == pytest.approx(state[1], rel=1e-3)
@@ -46,10 +53,9 @@ def test_start_tip_of_the_mirrored_problem_gives_the_same_g():
     assert g_m.GI == pytest.approx(g.GI, rel=5e-3)
 
 
-def test_peel_couple_matches_closed_form_over_a_4x_range_of_closure_length():
+def test_peel_couple_matches_closed_form_over_a_4x_range_of_closure_length(peel):
     """Coarse mesh (1 mm elements at the tip): Δ = 1, 2, 4 mm all within 2 % of closed form."""
-    sc = scene(peel_loads())
-    sol, model, state = _solve(sc)
+    sc, sol, model, state = peel
     exact = peel_g(sc, state[1])
     gs = [_g(model, state, dl) for dl in (1.0, 2.0, 4.0)]
     for g in gs:
