@@ -47,7 +47,7 @@ class DofMap:
 
     @property
     def n_full(self) -> int:
-        """Number of DOFs before elimination (20 per node)."""
+        """Number of DOFs before elimination (20 per node, plus the core enrichment)."""
         return int(self.free.size)
 
     def expand(self, u_free: np.ndarray) -> np.ndarray:
@@ -72,6 +72,7 @@ def build_dof_map(
     n_nodes: int,
     bonded: dict[str, np.ndarray],
     supports: list[NodeSupport],
+    mode_active: np.ndarray | None = None,
 ) -> DofMap:
     """Eliminate supports, then ties; number the remaining DOFs node by node.
 
@@ -83,8 +84,20 @@ def build_dof_map(
         For "top" and "bottom", a boolean array over nodes: True where the interface is tied.
     supports
         Supports at nodes.
+    mode_active
+        Core enrichment DOFs (:mod:`beam_element.core_basis`), shape ``(n_nodes, m)``: True where
+        the node's level carries the DOF, False where it is fixed at zero. They follow the
+        ``NODE_DOFS · n_nodes`` paper DOFs in the full vector (node i's at
+        ``NODE_DOFS · n_nodes + m i + j``) and are numbered with their node's paper DOFs, so the
+        reduced matrix stays banded. ``None``: no enrichment.
     """
-    n_full = NODE_DOFS * n_nodes
+    if mode_active is None:
+        mode_active = np.zeros((n_nodes, 0), dtype=bool)
+    mode_active = np.asarray(mode_active, dtype=bool)
+    if mode_active.ndim != 2 or mode_active.shape[0] != n_nodes:
+        raise ValueError(f"mode_active must have shape (n_nodes, m), got {mode_active.shape}")
+    n_paper = NODE_DOFS * n_nodes
+    n_full = n_paper + mode_active.size
     target = np.arange(n_full)  # the DOF each DOF follows
     sign = np.ones(n_full)
     for s in supports:
@@ -117,8 +130,14 @@ def build_dof_map(
         for core_name, face_name in pairs:
             c, f = global_dof(nodes, core_name), global_dof(nodes, face_name)
             target[c], sign[c] = target[f], sign[f]
+    sign[n_paper:] = np.where(mode_active.ravel(), 1.0, 0.0)
     independent = (target == np.arange(n_full)) & (sign != 0.0)
-    number = np.cumsum(independent) - 1
+    # Node-wise numbering: each node's paper DOFs, then its enrichment DOFs.
+    node_of = np.concatenate([np.arange(n_paper) // NODE_DOFS,
+                              np.repeat(np.arange(n_nodes), mode_active.shape[1])])
+    order = np.argsort(node_of, kind="stable")
+    number = np.empty(n_full, dtype=np.int64)
+    number[order] = np.cumsum(independent[order]) - 1
     free = np.where(sign != 0.0, number[target], -1)
     assert np.all(independent[target[sign != 0.0]]), "a constraint chain was left unresolved"
     return DofMap(free=free, sign=np.where(free >= 0, sign, 0.0), n_free=int(independent.sum()))

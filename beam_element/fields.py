@@ -41,17 +41,30 @@ def sample_layer(
     model: BeamModel, layer: str, u_full: np.ndarray, eta: np.ndarray, xi: np.ndarray,
     nonlinear: bool = True,
 ) -> LayerSample:
-    """Displacements and stresses of ``layer`` at points (η, ξ) of every element."""
-    op = model.layers[layer].at(np.asarray(eta, float), np.asarray(xi, float))
-    lengths = model.mesh.lengths
-    u_ref = u_full[model.element_dofs][:, op.dofs] * op.x_slope_scale(lengths)
-    g = gradients(op, u_ref, lengths)
-    ε = np.stack(green_lagrange(g) if nonlinear else linear_strains(g), axis=-1)
-    σ = ε @ op.stiffness.T  # eq. (3)
-    x = model.mesh.x[:-1, None] + 0.5 * (op.eta[None, :] + 1) * lengths[:, None]
-    z = np.broadcast_to(op.z_bottom + 0.5 * (op.xi + 1) * op.thickness, x.shape)
-    return LayerSample(x=x, z=np.array(z), u=u_ref @ op.N.T, w=u_ref @ op.M.T,
-                       sigma_x=σ[..., 0], sigma_z=σ[..., 1], tau=σ[..., 2])
+    """Displacements and stresses of ``layer`` at points (η, ξ) of every element.
+
+    The core is sampled group by group (its level may change along x, :class:`CoreGroup`).
+    """
+    eta, xi = np.asarray(eta, float), np.asarray(xi, float)
+    if layer == "core":
+        families = [(g.op, g.elements, g.dofs) for g in model.core]
+    else:
+        families = [(model.layers[layer], np.arange(model.mesh.n_elements),
+                     model.element_dofs[:, model.layers[layer].dofs])]
+    E, G = model.mesh.n_elements, eta.size
+    out = {k: np.empty((E, G)) for k in ("x", "z", "u", "w", "sigma_x", "sigma_z", "tau")}
+    for rows, els, dofs in families:
+        op = rows.at(eta, xi)
+        lengths = model.mesh.lengths[els]
+        u_ref = u_full[dofs] * op.x_slope_scale(lengths)
+        g = gradients(op, u_ref, lengths)
+        ε = np.stack(green_lagrange(g) if nonlinear else linear_strains(g), axis=-1)
+        σ = ε @ op.stiffness.T  # eq. (3)
+        out["x"][els] = model.mesh.x[els, None] + 0.5 * (op.eta[None, :] + 1) * lengths[:, None]
+        out["z"][els] = (op.z_bottom + 0.5 * (op.xi + 1) * op.thickness)[None, :]
+        out["u"][els], out["w"][els] = u_ref @ op.N.T, u_ref @ op.M.T
+        out["sigma_x"][els], out["sigma_z"][els], out["tau"][els] = σ[..., 0], σ[..., 1], σ[..., 2]
+    return LayerSample(**out)
 
 
 def _stations(per_element: int) -> np.ndarray:
@@ -133,6 +146,7 @@ class SectionFields:
     tau: np.ndarray
     von_mises: np.ndarray
     region: np.ndarray
+    core_level: np.ndarray  # (m,) the element's core level on core cells, 0 on face cells
 
     @property
     def deformed(self) -> np.ndarray:
@@ -140,20 +154,27 @@ class SectionFields:
         return self.points + self.displacement
 
 
+def core_rows(model: BeamModel, through: int) -> np.ndarray:
+    """ξ of the core's grid rows: ``through`` even rows plus every sublayer surface in use."""
+    cuts = [g.op.basis.partition(g.level) for g in model.core if g.op.basis is not None]
+    return np.unique(np.concatenate([np.linspace(-1.0, 1.0, through), *cuts]))
+
+
 def layer_grid(
     model: BeamModel, layer: str, u: np.ndarray, per_element: int = 4, through: int = 9,
-    nonlinear: bool = True,
+    nonlinear: bool = True, rows: np.ndarray | None = None,
 ) -> LayerSample:
     """One layer on a grid, arrays shaped ``(through, columns)``.
 
     ``per_element`` columns per element (plus the last node) by ``through`` rows from the layer's
-    bottom to its top.
+    bottom to its top (or at the reference coordinates ``rows`` in [−1, 1]).
     """
+    ξ1 = np.linspace(-1.0, 1.0, through) if rows is None else np.asarray(rows, dtype=float)
+    through = ξ1.size
     if through < 2:
         raise ValueError(f"need at least 2 rows through the thickness, got {through}")
     u_full = model.expand(u)
     η1 = _stations(per_element)
-    ξ1 = np.linspace(-1.0, 1.0, through)
     η, ξ = np.repeat(η1, through), np.tile(ξ1, η1.size)
     s = sample_layer(model, layer, u_full, η, ξ, nonlinear)
     e = sample_layer(model, layer, u_full, np.ones(through), ξ1, nonlinear)
@@ -170,11 +191,16 @@ def section_fields(
     model: BeamModel, u: np.ndarray, per_element: int = 4, through_core: int = 9,
     nonlinear: bool = True,
 ) -> SectionFields:
-    """Core and faces on one quadrilateral grid each, stacked (for deformed-shape pictures)."""
-    points, disp, cells, region, stress = [], [], [], [], []
+    """Core and faces on one quadrilateral grid each, stacked (for deformed-shape pictures).
+
+    The core's rows include every sublayer surface of its levels (:func:`core_rows`), so a
+    ParaView view of the cells shows the sublayers; cell data ``core_level`` says the level.
+    """
+    points, disp, cells, region, stress, level = [], [], [], [], [], []
     offset = 0
     for label, (layer, rows) in enumerate((("core", through_core), ("top", 2), ("bottom", 2))):
-        g = layer_grid(model, layer, u, per_element, rows, nonlinear)
+        xi = core_rows(model, rows) if layer == "core" else None
+        g = layer_grid(model, layer, u, per_element, rows, nonlinear, rows=xi)
         nz, nx = g.x.shape
         points.append(np.column_stack([g.x.ravel(), g.z.ravel()]))
         disp.append(np.column_stack([g.u.ravel(), g.w.ravel()]))
@@ -184,8 +210,12 @@ def section_fields(
         p0 = offset + j * nx + i
         cells.append(np.stack([p0, p0 + 1, p0 + 1 + nx, p0 + nx], axis=-1).reshape(-1, 4))
         region.append(np.full(cells[-1].shape[0], label))
+        column_element = np.minimum(np.arange(nx - 1) // per_element, model.mesh.n_elements - 1)
+        per_cell = np.broadcast_to(model.element_levels[column_element], (nz - 1, nx - 1))
+        level.append(per_cell.reshape(-1) if layer == "core" else np.zeros(cells[-1].shape[0]))
         offset += nz * nx
     S = np.concatenate(stress)
     return SectionFields(points=np.concatenate(points), displacement=np.concatenate(disp),
                          cells=np.concatenate(cells), sigma_x=S[:, 0], sigma_z=S[:, 1],
-                         tau=S[:, 2], von_mises=S[:, 3], region=np.concatenate(region))
+                         tau=S[:, 2], von_mises=S[:, 3], region=np.concatenate(region),
+                         core_level=np.concatenate(level).astype(int))

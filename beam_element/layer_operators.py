@@ -15,13 +15,20 @@ the same for every element, so the h/2 of z-slope DOFs is folded into the rows h
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 
-from beam_element.dofs import DOF_TABLE, NODE_DOFS, NODES_PER_ELEMENT, layer_element_dofs
-from beam_element.quadrature import tensor_rule
+from beam_element.core_basis import CoreBasis, mode_dofs
+from beam_element.dofs import (
+    DOF_TABLE,
+    ELEMENT_DOFS,
+    NODE_DOFS,
+    NODES_PER_ELEMENT,
+    layer_element_dofs,
+)
+from beam_element.quadrature import gauss_legendre, tensor_rule
 from beam_element.shape_functions import slope_scale_x, slope_scale_z, x_shape, z_shape
 
 
@@ -54,6 +61,13 @@ class LayerOperators:
         Gauss-weighted average along η at the same ξ (an assumed membrane strain). For a face,
         u is linear in x, so only the ½ w,x² term changes: it becomes its element mean, which
         removes the membrane locking of u-linear / w-cubic faces. Needs a tensor Gauss rule.
+    basis, level
+        The core's enrichment (:mod:`beam_element.core_basis`) and the level these rows carry;
+        ``None`` and 1 for the paper's layers. At level > 1 the element vector is *extended*:
+        indices 0..39 are the paper's DOFs of eq. (9), then each node's enrichment DOFs
+        (:func:`~beam_element.core_basis.mode_dofs`), node i first.
+    u_mask
+        Boolean mask of the u DOFs (``None``: read from the DOF table).
     """
 
     name: str
@@ -72,9 +86,15 @@ class LayerOperators:
     M_xi: np.ndarray
     x_slope: np.ndarray
     membrane_average: bool = False
+    basis: CoreBasis | None = None
+    level: int = 1
+    u_mask: np.ndarray | None = None
 
     def at(self, eta: np.ndarray, xi: np.ndarray) -> LayerOperators:
         """The same layer's rows at other points (weights set to zero)."""
+        if self.basis is not None and self.level > 1:
+            return build_core_operators(self.thickness, self.z_bottom, self.stiffness,
+                                        self.basis, self.level, eta=eta, xi=xi)
         return build_layer_operators(
             self.name, self.thickness, self.z_bottom, self.stiffness, eta=eta, xi=xi
         )
@@ -96,6 +116,8 @@ class LayerOperators:
 
         N rows vanish off them, M rows on them.
         """
+        if self.u_mask is not None:
+            return self.u_mask
         return np.array([DOF_TABLE[int(d) % NODE_DOFS].field == "u" for d in self.dofs])
 
     @cached_property
@@ -183,4 +205,71 @@ def build_layer_operators(
         name=name, dofs=dofs, thickness=float(thickness), z_bottom=float(z_bottom),
         stiffness=np.asarray(stiffness, dtype=float), eta=eta, xi=xi, weight=weight,
         x_slope=x_slope, membrane_average=bool(membrane_average and gauss is not None), **rows,
+    )
+
+
+def build_core_operators(
+    thickness: float,
+    z_bottom: float,
+    stiffness: np.ndarray,
+    basis: CoreBasis,
+    level: int,
+    *,
+    gauss: tuple[int, int] | None = None,
+    eta: np.ndarray | None = None,
+    xi: np.ndarray | None = None,
+) -> LayerOperators:
+    """Rows of the core at ``level`` of ``basis``: the paper's 24 DOFs plus the enrichment.
+
+    At level 1 this is :func:`build_layer_operators` of the core (the paper's element, bit for
+    bit) with the tensor rule ``gauss``. At level > 1 the rule is ``gauss[0]`` points along η
+    times the basis' exact rule in ξ
+    (:meth:`~beam_element.core_basis.CoreBasis.rule`), η slowest as in
+    :func:`~beam_element.quadrature.tensor_rule`.
+    """
+    if gauss is not None and level == 1:
+        return replace(build_layer_operators("core", thickness, z_bottom, stiffness,
+                                             gauss=gauss), basis=basis)
+    if gauss is not None:
+        e1, we = gauss_legendre(gauss[0])
+        x1, wx = basis.rule(level)
+        eta, xi = np.repeat(e1, x1.size), np.tile(x1, e1.size)
+        weight = np.outer(we, wx).ravel()
+    elif eta is not None and xi is not None:
+        eta = np.atleast_1d(np.asarray(eta, dtype=float))
+        xi = np.atleast_1d(np.asarray(xi, dtype=float))
+        weight = np.zeros_like(eta)
+    else:
+        raise ValueError("give either gauss or both eta and xi")
+    paper = build_layer_operators("core", thickness, z_bottom, stiffness, eta=eta, xi=xi)
+    if level == 1:
+        return replace(paper, weight=weight, basis=basis)
+    modes = mode_dofs(basis, level)
+    m = len(modes)
+    cols = {key: [getattr(paper, key)] for key in ("N", "M", "N_eta", "N_xi", "M_eta", "M_xi")}
+    zero = np.zeros((eta.size, NODES_PER_ELEMENT * m))
+    for key in cols:
+        cols[key].append(zero.copy())
+    x_slope = np.zeros(NODES_PER_ELEMENT * m, dtype=bool)
+    is_u = np.zeros(NODES_PER_ELEMENT * m, dtype=bool)
+    phi = [f(xi) for f in basis.functions[:basis.count(level)]]
+    for node in range(NODES_PER_ELEMENT):
+        for j, d in enumerate(modes):
+            a = node * m + j
+            X, X_eta = x_shape(d.x_kind, node, eta)
+            Z, Z_xi = phi[d.function]
+            if basis.functions[d.function].kind == "slope":  # DOF = ∂/∂z: ξ-slope × h/2
+                Z, Z_xi = 0.5 * thickness * Z, 0.5 * thickness * Z_xi
+            x_slope[a], is_u[a] = slope_scale_x(d.x_kind), d.field == "u"
+            field = "N" if d.field == "u" else "M"
+            cols[field][1][:, a] = X * Z
+            cols[field + "_eta"][1][:, a] = X_eta * Z
+            cols[field + "_xi"][1][:, a] = X * Z_xi
+    rows = {key: np.concatenate(v, axis=1) for key, v in cols.items()}
+    dofs = np.concatenate([paper.dofs, ELEMENT_DOFS + np.arange(NODES_PER_ELEMENT * m)])
+    return LayerOperators(
+        name="core", dofs=dofs, thickness=float(thickness), z_bottom=float(z_bottom),
+        stiffness=np.asarray(stiffness, dtype=float), eta=eta, xi=xi, weight=weight,
+        x_slope=np.concatenate([paper.x_slope, x_slope]), basis=basis, level=level,
+        u_mask=np.concatenate([paper.u_columns, is_u]), **rows,
     )

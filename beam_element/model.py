@@ -24,6 +24,7 @@ from beam_element.contact import (
     in_contact,
     penalty_response,
 )
+from beam_element.core_basis import CoreBasis, mode_dofs
 from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
 from beam_element.element import (
     GeometricProducts,
@@ -32,7 +33,11 @@ from beam_element.element import (
     layer_state,
     layer_tangent,
 )
-from beam_element.layer_operators import LayerOperators, build_layer_operators
+from beam_element.layer_operators import (
+    LayerOperators,
+    build_core_operators,
+    build_layer_operators,
+)
 from beam_element.loads import patch_load, point_load, probe_row
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
@@ -55,6 +60,50 @@ class ContactSummary:
     outside_reach: int = 0  # pairs in contact projecting beyond the searched segments
 
 
+@dataclass(frozen=True)
+class CoreGroup:
+    """The core elements of one level: their rows, products and (extended) DOF indices."""
+
+    level: int
+    elements: np.ndarray  # (E_g,) element indices, increasing
+    op: LayerOperators
+    products: GeometricProducts
+    dofs: np.ndarray  # (E_g, n) full DOF indices of op.dofs
+
+
+def node_levels(element_levels: np.ndarray) -> np.ndarray:
+    """Level of each node: the lowest of its elements' (so every element is conforming).
+
+    An enrichment amplitude lives at a node only if every element there carries it; the
+    element of the higher level then sees it vanish at that node.
+    """
+    e = np.asarray(element_levels, dtype=int)
+    return np.minimum(np.concatenate([e[:1], e]), np.concatenate([e, e[-1:]]))
+
+
+def core_groups(
+    basis: CoreBasis,
+    element_levels: np.ndarray,
+    element_dofs: np.ndarray,
+    n_nodes: int,
+    make_op: object,
+) -> list[CoreGroup]:
+    """Group core elements by level; extended DOFs = paper 40, then each node's enrichment."""
+    m = 4 * basis.count(basis.max_level)  # enrichment DOFs per node in the full vector
+    groups = []
+    for level in np.unique(element_levels):
+        els = np.flatnonzero(element_levels == level)
+        op = make_op(int(level))
+        k = len(mode_dofs(basis, int(level)))
+        ext = [element_dofs[els]]
+        for node in (0, 1):
+            ext.append(NODE_DOFS * n_nodes + m * (els + node)[:, None] + np.arange(k)[None, :])
+        ext_dofs = np.concatenate(ext, axis=1)
+        groups.append(CoreGroup(level=int(level), elements=els, op=op,
+                                products=geometric_products(op), dofs=ext_dofs[:, op.dofs]))
+    return groups
+
+
 @dataclass
 class BeamModel:
     """Equilibrium R(u, λ) = f_int(u) − λ f_ref on the free DOFs of the beam model."""
@@ -71,6 +120,8 @@ class BeamModel:
     probe_rows: dict[str, np.ndarray]
     face_thickness: dict[str, float]
     smoothing: float = 0.0  # contact regularisation width s (mm), see beam_element.contact
+    core: list[CoreGroup] = field(default_factory=list)  # core elements grouped by level
+    element_levels: np.ndarray | None = None  # core level of every element
     pattern: ReducedPattern = field(init=False)
     committed: dict[str, ContactSummary] = field(default_factory=dict)
     max_penetration_seen: float = 0.0
@@ -81,7 +132,16 @@ class BeamModel:
     def __post_init__(self) -> None:
         e = np.arange(self.mesh.n_elements)[:, None]
         self.element_dofs = NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :]
-        self.block_dofs = [self.element_dofs[:, self.layers[n].dofs] for n in LAYERS]
+        if not self.core:  # the paper's core everywhere
+            op = self.layers["core"]
+            self.core = [CoreGroup(1, np.arange(self.mesh.n_elements), op, self.products["core"],
+                                   self.element_dofs[:, op.dofs])]
+        if self.element_levels is None:
+            self.element_levels = np.ones(self.mesh.n_elements, dtype=int)
+        # Block families: top face, core groups by level, bottom face, contact groups.
+        self.block_dofs = [self.element_dofs[:, self.layers["top"].dofs]]
+        self.block_dofs += [g.dofs for g in self.core]
+        self.block_dofs += [self.element_dofs[:, self.layers["bottom"].dofs]]
         self.block_dofs += [p.block_dofs for p in self.pairs]
         self.pattern = reduced_pattern(self.block_dofs, self.dof_map)
         self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
@@ -143,7 +203,7 @@ class BeamModel:
 
     # --- evaluation -----------------------------------------------------------------------
     def expand(self, u: np.ndarray) -> np.ndarray:
-        """Full DOF vector (20 per node) of free DOFs ``u``."""
+        """Full DOF vector (20 per node, then the core enrichment) of free DOFs ``u``."""
         u = np.asarray(u, dtype=float)
         if u.shape != (self.size,):
             raise ValueError(f"expected a vector of {self.size} free DOFs, got shape {u.shape}")
@@ -165,26 +225,37 @@ class BeamModel:
         self._cache = (np.array(u, dtype=float, copy=True), f, K, states)
         return f, K
 
-    def _forces(self, u_full: np.ndarray) -> tuple[np.ndarray, dict[str, list[LayerState]]]:
-        """Internal force on the full DOFs and the layer states (per chunk) it came from."""
-        forces, states = [], {}
+    def _families(self) -> list[tuple[LayerOperators, GeometricProducts, np.ndarray, np.ndarray]]:
+        """(rows, products, elements, DOFs) of each element block family, in block order."""
+        every = np.arange(self.mesh.n_elements)
+        out = [(self.layers["top"], self.products["top"], every, self.block_dofs[0])]
+        out += [(g.op, g.products, g.elements, g.dofs) for g in self.core]
+        out += [(self.layers["bottom"], self.products["bottom"], every,
+                 self.block_dofs[len(self.core) + 1])]
+        return out
+
+    def _forces(self, u_full: np.ndarray) -> tuple[np.ndarray, list[list[LayerState]]]:
+        """Internal force on the full DOFs and the layer states (per family, chunk)."""
+        forces, states = [], []
         lengths = self.mesh.lengths
-        u_e = u_full[self.element_dofs]
-        for name in LAYERS:
-            op = self.layers[name]
-            states[name] = [layer_state(op, u_e[s:s + CHUNK], lengths[s:s + CHUNK], self.width)
-                            for s in range(0, self.mesh.n_elements, CHUNK)]
-            forces.append(np.concatenate([st.f for st in states[name]]))
+        for op, _, els, dofs in self._families():
+            # layer_state reads u_e[:, op.dofs]: hand it the family's DOFs in op.dofs' slots.
+            u_e = np.zeros((els.size, int(op.dofs.max()) + 1))
+            u_e[:, op.dofs] = u_full[dofs]
+            family = [layer_state(op, u_e[s:s + CHUNK], lengths[els[s:s + CHUNK]], self.width)
+                      for s in range(0, els.size, CHUNK)]
+            states.append(family)
+            forces.append(np.concatenate([st.f for st in family]))
         for pairs in self.pairs:
             forces.append(penalty_response(pairs, u_full, self.penalty, self.smoothing)[0])
         return scatter_vector(u_full.size, self.block_dofs, forces), states
 
     def _tangent_blocks(
-        self, u_full: np.ndarray, states: dict[str, list[LayerState]]
+        self, u_full: np.ndarray, states: list[list[LayerState]]
     ) -> list[np.ndarray]:
         """Local tangent blocks (layers, then contact) at the layer states of ``u_full``."""
-        blocks = [np.concatenate([layer_tangent(self.layers[name], st, self.products[name])
-                                  for st in states[name]]) for name in LAYERS]
+        blocks = [np.concatenate([layer_tangent(op, st, products) for st in family])
+                  for (op, products, _, _), family in zip(self._families(), states, strict=True)]
         for pairs in self.pairs:
             blocks.append(penalty_response(pairs, u_full, self.penalty, self.smoothing)[1])
         return blocks
@@ -282,6 +353,8 @@ def build_model(
     face_membrane: str = "paper",
     contact_search: str = "same-x",
     contact_reach: float = DEFAULT_REACH,
+    core_level: int | np.ndarray | None = None,
+    core_basis: str = "sublayers",
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -322,19 +395,19 @@ def build_model(
     contact_reach
         Closest-point search: the segments within this distance (mm) on each side of a node, at
         least one per side, are searched (default ``DEFAULT_REACH``).
+    core_level
+        Level of the core hierarchy (:mod:`beam_element.core_basis`): one integer for every
+        element, or one per element of the mesh :func:`beam_mesh` gives (see
+        :mod:`beam_element.core_levels`); default 1, the paper's core.
+    core_basis
+        Enrichment family of levels > 1: ``"sublayers"`` (default) or ``"polynomial"``.
     """
     if face_membrane not in ("paper", "averaged"):
         raise ValueError(f"face_membrane must be 'paper' or 'averaged', got {face_membrane!r}")
     options = getattr(scene, "beam_model", None)
     if elements is None:
         elements = getattr(options, "elements", 120)
-    if grading not in GRADINGS:
-        raise ValueError(f"grading must be one of {GRADINGS}, got {grading!r}")
-    mesh = build_mesh(scene.length, elements, mesh_stations(scene),
-                      centres=refinement_centres(scene),
-                      zones=refinement_zones(scene) if grading == "graded" else (),
-                      grading="uniform" if grading == "uniform" else "graded", growth=growth,
-                      size_ratio=size_ratio)
+    mesh = beam_mesh(scene, elements, grading=grading, growth=growth, size_ratio=size_ratio)
     if not (np.isfinite(scene.width) and scene.width > 0):
         raise ValueError(f"beam width must be positive, got {scene.width!r}")
     orders = dict(EXACT_ORDER)
@@ -349,13 +422,28 @@ def build_model(
         n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n],
         membrane_average=(n != "core" and face_membrane == "averaged")) for n in LAYERS}
     products = {n: geometric_products(op) for n, op in layers.items()}
+    levels = np.broadcast_to(np.asarray(1 if core_level is None else core_level, dtype=int),
+                             (mesh.n_elements,)).copy()
+    if np.any(levels < 1):
+        raise ValueError(f"core levels must be >= 1, got {levels.min()}")
+    basis = CoreBasis(core_basis, int(levels.max()))
+    groups: list[CoreGroup] = []
+    m = 4 * basis.count(basis.max_level)
+    if basis.max_level > 1:
+        e = np.arange(mesh.n_elements)[:, None]
+        groups = core_groups(
+            basis, levels, NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :], mesh.n_nodes,
+            lambda level: build_core_operators(hc, z_bottom["core"], stiffness["core"], basis,
+                                               level, gauss=orders["core"]))
+    mode_active = (np.arange(m)[None, :]
+                   < 4 * np.array([basis.count(int(k)) for k in node_levels(levels)])[:, None])
 
     tol = 1e-9 * scene.length
     bonded = {i: np.array([scene.is_bonded(i, float(x), tol) for x in mesh.x])
               for i in ("top", "bottom")}
     supports = [NodeSupport(mesh.node_at(s.x, 1e-6 * scene.length), face, s.type)
                 for s in scene.supports for face in s.faces]
-    dof_map = build_dof_map(mesh.n_nodes, bonded, supports)
+    dof_map = build_dof_map(mesh.n_nodes, bonded, supports, mode_active)
 
     f_ref = np.zeros(NODE_DOFS * mesh.n_nodes)
     for load in scene.loads:
@@ -363,7 +451,9 @@ def build_model(
             f_ref += point_load(mesh, load.on, load.x, load.force)
         else:
             f_ref += patch_load(mesh, load.on, *load.span, load.force)
-    probes = {p.name: probe_row(mesh, p.on, p.x) for p in scene.probes}
+    f_ref = np.concatenate([f_ref, np.zeros(mode_active.size)])  # no load on the enrichment
+    probes = {p.name: np.concatenate([probe_row(mesh, p.on, p.x), np.zeros(mode_active.size)])
+              for p in scene.probes}
 
     pairs = [group for i in ("top", "bottom") if np.any(~bonded[i])
              for group in contact_pair_groups(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width,
@@ -378,5 +468,23 @@ def build_model(
         name=scene.name, mesh=mesh, width=float(scene.width), layers=layers, products=products,
         dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,
         probe_rows=probes, face_thickness={"top": ht, "bottom": hb},
-        smoothing=float(contact_smoothing),
+        smoothing=float(contact_smoothing), core=groups, element_levels=levels,
     )
+
+
+def beam_mesh(
+    scene: object,
+    elements: int,
+    *,
+    grading: str = "graded",
+    growth: float = DEFAULT_GROWTH,
+    size_ratio: float = DEFAULT_SIZE_RATIO,
+) -> BeamMesh:
+    """The nodes :func:`build_model` puts on ``scene`` for ``elements`` elements."""
+    if grading not in GRADINGS:
+        raise ValueError(f"grading must be one of {GRADINGS}, got {grading!r}")
+    return build_mesh(scene.length, elements, mesh_stations(scene),
+                      centres=refinement_centres(scene),
+                      zones=refinement_zones(scene) if grading == "graded" else (),
+                      grading="uniform" if grading == "uniform" else "graded", growth=growth,
+                      size_ratio=size_ratio)

@@ -15,9 +15,18 @@ import numpy as np
 import scipy.sparse as sp
 
 from beam_element.contact import NORMAL_SIGN
+from beam_element.core_basis import MAX_LEVEL
+from beam_element.core_levels import (
+    LevelChoice,
+    auto_levels,
+    level_counts,
+    raise_levels,
+    state_estimate,
+    zone_levels,
+)
 from beam_element.fields import profile_columns, section_fields
-from beam_element.fracture import beam_tips, history_columns, tip_releases
-from beam_element.model import BeamModel, build_model
+from beam_element.fracture import beam_tips, history_columns, level_warning, tip_releases
+from beam_element.model import BeamModel, beam_mesh, build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
 
@@ -35,6 +44,10 @@ DESIRED_ITERATIONS = 8
 # meets the bound at every resolution.
 PENALTY_RESTARTS = 2
 PENALTY_GROWTH = 2.0
+# "auto" core levels: at the end of the path the indicator is re-evaluated on the converged state
+# (beam_element.core_levels.state_estimate); above the tolerance the levels are raised where it
+# points and the path is rerun, at most CORE_RECHECKS times.
+CORE_RECHECKS = 3
 
 
 @dataclass(frozen=True)
@@ -176,31 +189,55 @@ def run(
         raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
     bm = scene.beam_model
     options = {"grading": getattr(bm, "grading", "graded"),
-               "face_membrane": getattr(bm, "face_membrane", "paper"), **(model_options or {})}
-    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
+               "face_membrane": getattr(bm, "face_membrane", "paper"),
+               "core_basis": getattr(bm, "core_basis", "sublayers"), **(model_options or {})}
+    choice = choose_core_levels(scene, elements, options)
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []
     raised: list[float] = []
     if not nonlinear:
+        model = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                            **{**options, "core_level": choice.levels})
         states, message = _linear_states(model, scene)
         converged = True
     else:
-        while True:
-            states, message, converged, limit_points = _follow(model, scene, progress)
-            pen, bound = _max_penetration(model, states), model.penetration_bound()
-            if pen <= bound or len(raised) == PENALTY_RESTARTS:
+        for recheck in range(CORE_RECHECKS + 1):
+            model, states, message, converged, limit_points, raised = _follow_penalised(
+                scene, elements, {**options, "core_level": choice.levels}, progress)
+            if choice.how != "auto" or states[-1].load_factor == 0.0:
                 break
-            raised.append(model.penalty)
-            penalty = model.penalty * PENALTY_GROWTH * pen / bound
-            model = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
-                                **{**options, "contact_penalty": penalty})
+            last = states[-1]
+            up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                             **{**options, "core_level": np.minimum(choice.levels + 1, MAX_LEVEL)})
+            estimate, shares = state_estimate(model, last.u, last.load_factor, up, a.until_probe)
+            choice.passes.append({"stage": f"path step {last.step}",
+                                  "elements_per_level": level_counts(choice.levels),
+                                  "estimate": estimate})
+            choice.estimate = estimate
+            tol, top = float(bm.tolerance), int(bm.max_core_level)
+            if estimate <= tol or not np.any(choice.levels < top) or recheck == CORE_RECHECKS:
+                break
+            choice.levels = raise_levels(choice.levels, shares, estimate, tol, top)
+            if progress is not None:
+                progress(CoreRecheck(estimate, level_counts(choice.levels)))
         if raised:
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
+        if choice.how == "auto" and choice.estimate is not None and \
+                choice.estimate > float(bm.tolerance):
+            message += (f"; WARNING: the core's estimated error {100 * choice.estimate:.2g} % "
+                        f"exceeds the tolerance {100 * float(bm.tolerance):.2g} % at "
+                        f"max_core_level {bm.max_core_level}")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(_growth_summary(scene, solution))
+    solution.extra["core"] = {
+        "how": choice.how, "basis": options["core_basis"],
+        "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,
+        "passes": choice.passes,
+        "tolerance": getattr(bm, "tolerance", None) if choice.how == "auto" else None,
+    }
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
 
@@ -211,6 +248,87 @@ def _growth_summary(scene: object, solution: Solution) -> dict[str, object]:
 
     onset = growth_onset(scene, solution.history)
     return {"debond_growth": onset} if onset else {}
+
+
+def choose_core_levels(scene: object, elements: int | None, options: dict) -> LevelChoice:
+    """The core level of every element: given, from ``[beam_model]``, or chosen by "auto".
+
+    ``options["core_level"]`` (an integer or one level per element) overrides the scene. Else
+    ``[beam_model] core`` is a level or ``"auto"`` (:func:`~beam_element.core_levels.auto_levels`
+    on the linear step against ``tolerance``, up to ``max_core_level``); ``core_zones`` raise the
+    levels over their stretches in both cases.
+    """
+    bm = scene.beam_model
+    n = elements if elements is not None else getattr(bm, "elements", 240)
+    mesh_options = {k: options[k] for k in ("grading", "growth", "size_ratio") if k in options}
+    mesh = beam_mesh(scene, n, **mesh_options)
+    given = options.get("core_level")
+    if given is not None:
+        levels = np.broadcast_to(np.asarray(given, dtype=int), (mesh.n_elements,)).copy()
+        return LevelChoice(levels=levels, how="explicit")
+    core = getattr(bm, "core", 1)
+    zones = tuple(getattr(bm, "core_zones", ()))
+    if core != "auto":
+        return LevelChoice(levels=zone_levels(mesh, int(core), zones), how="explicit")
+    gauss = _gauss_orders(scene)
+    floor = zone_levels(mesh, 1, zones)
+
+    def build(levels: np.ndarray) -> BeamModel:
+        return build_model(scene, elements=n, gauss=gauss,
+                           **{**options, "core_level": np.maximum(levels, floor)})
+
+    sign = _load_sign(build(floor), scene)
+    choice = auto_levels(build, lambda m: linear_solution(m, sign)[0], mesh.n_elements,
+                         float(getattr(bm, "tolerance", 0.01)),
+                         int(getattr(bm, "max_core_level", 4)), probe=scene.analysis.until_probe)
+    choice.levels = np.maximum(choice.levels, floor)
+    return choice
+
+
+def _load_sign(model: BeamModel, scene: object) -> float:
+    """Sign of the load factor the analysis heads for (unilateral contact is not odd in λ)."""
+    a = scene.analysis
+    if a.until_probe is not None:
+        u, _ = linear_solution(model, 1.0)
+        value = float(model.probe_vector(a.until_probe) @ u)
+        return 1.0 if value * a.until_value >= 0 else -1.0
+    if a.until_load_factor is not None and a.until_load_factor < 0:
+        return -1.0
+    return 1.0
+
+
+@dataclass(frozen=True)
+class CoreRecheck:
+    """Progress event: the path is rerun with raised core levels (the bar restarts)."""
+
+    estimate: float
+    elements_per_level: dict[str, int]
+    step: int = 0
+    load_factor: float = 0.0
+
+    @property
+    def message(self) -> str:
+        """What a user is told."""
+        return (f"core error estimate {100 * self.estimate:.2g} % above tolerance: rerunning "
+                f"the path with elements per core level {self.elements_per_level}")
+
+
+def _follow_penalised(
+    scene: object, elements: int | None, options: dict,
+    progress: Callable[[object], None] | None,
+) -> tuple[BeamModel, list[ConvergedState], str, bool, list[LimitPoint], list[float]]:
+    """Follow the path; rerun with a stiffer penalty while converged states penetrate too deep."""
+    raised: list[float] = []
+    model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
+    while True:
+        states, message, converged, limit_points = _follow(model, scene, progress)
+        pen, bound = _max_penetration(model, states), model.penetration_bound()
+        if pen <= bound or len(raised) == PENALTY_RESTARTS:
+            return model, states, message, converged, limit_points, raised
+        raised.append(model.penalty)
+        penalty = model.penalty * PENALTY_GROWTH * pen / bound
+        model = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                            **{**options, "contact_penalty": penalty})
 
 
 def _follow(
@@ -248,7 +366,8 @@ def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> Fi
     """Faces and core of ``state`` on one quad grid (``section_fields``) as a ParaView frame.
 
     Point data: σ_x, σ_z, τ, von Mises (MPa, 2nd Piola-Kirchhoff); cell data: ``region``
-    (0 core, 1 top face, 2 bottom face). Points are reference (x, z), displacement (u, w) in mm.
+    (0 core, 1 top face, 2 bottom face) and ``core_level`` (0 on faces). Points are reference
+    (x, z), displacement (u, w) in mm.
     """
     f = section_fields(model, state.u, nonlinear=nonlinear)
     return FieldFrame(
@@ -256,7 +375,7 @@ def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> Fi
         displacement=f.displacement,
         point_data={"sigma_x": f.sigma_x, "sigma_z": f.sigma_z, "tau": f.tau,
                     "von_mises": f.von_mises},
-        cell_data={"region": f.region.astype(float)},
+        cell_data={"region": f.region.astype(float), "core_level": f.core_level.astype(float)},
     )
 
 
@@ -267,6 +386,8 @@ def _solution(
     history = []
     max_pen = max_slide = 0.0
     tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
+    if level_warning(model, tips):
+        message += "; " + level_warning(model, tips)
     for s in states:
         summary = model.contact_summary(s.u) if nonlinear else {}
         pen = max((c.max_penetration for c in summary.values()), default=0.0)

@@ -50,6 +50,9 @@ class PathProgress:
         self.last_step = int(getattr(state, "step", self.last_step + 1))
         if self.bar is None:
             return
+        note = getattr(state, "message", None)  # an event that is not a step (e.g. a rerun)
+        if isinstance(note, str):
+            self.bar.write(f"{self.label}: {note}")
         lam = float(getattr(state, "load_factor", 0.0))
         probes = dict(getattr(state, "probes", {}) or {})
         target = int(round(1000 * self.fraction(lam, probes)))

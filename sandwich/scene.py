@@ -19,6 +19,8 @@ SUPPORT_SITES = ("top", "bottom", "faces")
 SUPPORT_TYPES = ("pin", "roller", "clamp")
 ANALYSIS_KINDS = ("linear", "nonlinear")
 CONTROLS = ("load", "displacement", "arc-length")
+CORE_BASES = ("sublayers", "polynomial")  # enrichment families of the beam's core levels
+MAX_CORE_LEVEL = 6
 
 
 @dataclass(frozen=True)
@@ -178,6 +180,20 @@ class BeamModelOptions:
     gauss_z: int | None = None
     contact_penalty: float | None = None
     profile_every: int = 0  # 0: profiles at the last step only
+    core: int | str = "auto"  # core level 1 (the paper's) .. MAX_CORE_LEVEL, or "auto"
+    core_basis: str = "sublayers"  # "sublayers" (graded C1 cubic sublayers) | "polynomial"
+    tolerance: float = 0.01  # "auto": target relative error of the core's through-thickness field
+    max_core_level: int = 4  # "auto": highest level it may choose
+    core_zones: tuple[CoreZone, ...] = ()  # explicit levels over stretches of x
+
+
+@dataclass(frozen=True)
+class CoreZone:
+    """A stretch [start, end] of x (mm) where the beam's core has at least ``level``."""
+
+    start: float
+    end: float
+    level: int
 
 
 @dataclass(frozen=True)

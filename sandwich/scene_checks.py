@@ -13,12 +13,15 @@ from typing import Any
 from sandwich.scene import (
     ANALYSIS_KINDS,
     CONTROLS,
+    CORE_BASES,
     FACES,
     INTERFACES,
+    MAX_CORE_LEVEL,
     SUPPORT_SITES,
     SUPPORT_TYPES,
     Analysis,
     BeamModelOptions,
+    CoreZone,
     Debond,
     Layer,
     Load,
@@ -169,6 +172,10 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
     probes = _probes(r, data.get("probes", []), L)
     analysis = _analysis(r, data.get("analysis", {}), probes)
     beam_model = _beam_model(r, data.get("beam_model", {}))
+    for i, z in enumerate(beam_model.core_zones):
+        if L is not None and (z.start < 0 or z.end > L):
+            r.fail(f"beam_model.core_zones.{i}", f"[{z.start:g}, {z.end:g}] is not inside the "
+                   f"beam [0, {L:g}]")
     reference2d = _reference2d(r, data.get("reference2d", {}))
     if not r.problems:
         _check_mechanism(r, supports, debonds, length)
@@ -424,11 +431,44 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     key = "beam_model"
     t = r.table(tbl, key, ("elements", "grading", "face_membrane", "gauss_x", "gauss_z",
-                           "contact_penalty", "profile_every"))
+                           "contact_penalty", "profile_every", "core", "core_basis", "tolerance",
+                           "max_core_level", "core_zones"))
     if t is None:
         return BeamModelOptions()
     d = BeamModelOptions()
+    core: Any = d.core
+    if "core" in t:
+        core = t["core"]
+        if core != "auto" and (isinstance(core, bool) or not isinstance(core, int)
+                               or not 1 <= core <= MAX_CORE_LEVEL):
+            r.fail("beam_model.core", f"expected \"auto\" or a core level 1..{MAX_CORE_LEVEL}, "
+                   f"got {core!r}")
+            core = d.core
+    tolerance = r.number(t, "tolerance", key, default=d.tolerance, positive=True)
+    if tolerance is not None and not 1e-6 <= tolerance <= 0.5:
+        r.fail("beam_model.tolerance", f"must be between 1e-6 and 0.5 (a relative error), "
+               f"got {tolerance:g}")
+        tolerance = None
+    zones = []
+    for i, z in enumerate(r.array_of_tables(t.get("core_zones", []), "beam_model.core_zones")):
+        zkey = f"beam_model.core_zones.{i}"
+        zt = r.table(z, zkey, ("start", "end", "level"), required=("start", "end", "level"))
+        if zt is None:
+            continue
+        a, b = r.number(zt, "start", zkey), r.number(zt, "end", zkey)
+        level = r.integer(zt, "level", zkey, lo=1, hi=MAX_CORE_LEVEL)
+        if a is not None and b is not None and b <= a:
+            r.fail(f"{zkey}.end", f"must be greater than start ({b:g} <= {a:g})")
+        elif None not in (a, b, level):
+            zones.append(CoreZone(start=a, end=b, level=level))
     return BeamModelOptions(
+        core=core,
+        core_basis=r.choice(t, "core_basis", key, CORE_BASES, default=d.core_basis)
+        or d.core_basis,
+        tolerance=tolerance or d.tolerance,
+        max_core_level=r.integer(t, "max_core_level", key, default=d.max_core_level, lo=1,
+                                 hi=MAX_CORE_LEVEL) or d.max_core_level,
+        core_zones=tuple(zones),
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
         grading=r.choice(t, "grading", key, ("graded", "tips", "uniform"), default=d.grading)
         or d.grading,

@@ -36,8 +36,13 @@ def sandwich_scene(
     elements=60,
     analysis=None,
     name="test",
+    core_level=1,
 ):
-    """Simply supported (bottom face, pin + roller) three-point bend unless told otherwise."""
+    """Simply supported (bottom face, pin + roller) three-point bend unless told otherwise.
+
+    ``core_level``: the beam's core level, 1 (the paper's element) unless a test asks for the
+    hierarchy (``"auto"`` or a higher level).
+    """
     if supports is None:
         supports = (Support(0.0, "bottom", "pin"), Support(length, "bottom", "roller"))
     if loads is None:
@@ -52,7 +57,7 @@ def sandwich_scene(
         debonds=tuple(debonds), supports=tuple(supports), loads=tuple(loads),
         probes=tuple(probes),
         analysis=analysis or Analysis(kind="linear", until_load_factor=1.0),
-        beam_model=BeamModelOptions(elements=elements),
+        beam_model=BeamModelOptions(elements=elements, core=core_level),
     )
 
 

@@ -1,5 +1,7 @@
 """Every shipped scene (scenes/*.toml) runs to its `until` with the beam model at a test resolution.
 
+Core level 1 (the paper's element; the scenes' default "auto" is run by the heavy tests of
+test_core_auto.py).
 Resolution: 40 elements (7.5 mm; the scene default is finer). Coarse, so the loads are not
 converged values, but the whole path is followed with the scene's own analysis settings (control,
 tolerances, max_steps) and contact law: the checks are that the target is reached (the solver's
@@ -27,7 +29,7 @@ def test_all_shipped_scenes_are_listed():
 @pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
 def test_shipped_scene_reaches_its_until(path):
     scene = load_scene(path)
-    result = run(scene, elements=TEST_ELEMENTS)
+    result = run(scene, elements=TEST_ELEMENTS, model_options={"core_level": 1})
     sol = result.solution
     assert sol.converged, sol.message
     a = scene.analysis

@@ -31,12 +31,13 @@ T_FACE, H_CORE, WIDTH, LENGTH, D_COUPLE = 1.0, 10.0, 20.0, 200.0, 20.0
 
 
 def scene(loads, *, a=60.0, e_core=200.0, level="coarse", elements=240, until=0.1,
-          probe_on="top", tol=None, mirror=False):
+          probe_on="top", tol=None, mirror=False, core=1):
     """The debonded strip with ``loads`` (list of (face, x, force)), displacement-controlled.
 
     The path is driven by w of ``probe_on`` at x = 0 up to ``until`` mm (small: G is a linear
     elasticity check; 0.1 mm is 0.1 % of a face rotation). ``mirror``: the same problem
-    reflected about mid-span (x -> L - x), whose tip is the debond's ``start``.
+    reflected about mid-span (x -> L - x), whose tip is the debond's ``start``. ``core``: the
+    beam's core level (1 = the paper's element; "auto" = the scene default since 2026-12-01).
     """
     def at(x):
         return LENGTH - x if mirror else x
@@ -59,7 +60,7 @@ def scene(loads, *, a=60.0, e_core=200.0, level="coarse", elements=240, until=0.
         "probes": [{"name": "w0", "on": probe_on, "x": at(0.0)}],
         "analysis": analysis,
         "reference2d": {"level": level},
-        "beam_model": {"elements": elements},
+        "beam_model": {"elements": elements, "core": core},
     }
     return build_scene(data, "<fracture-check>")
 

@@ -115,3 +115,17 @@ def test_virtual_extension_energy_converges_to_the_closed_form():
     fine, vcct_fine = _extension_release(960)
     assert 0.97 < coarse < fine < 1.0
     assert abs(vcct_fine - 1.0) < 0.01 and abs(vcct_coarse - 1.0) < 0.01
+
+
+def test_mixed_core_levels_at_the_tip_are_flagged():
+    """"auto" puts a level-2 patch around the tip of the sliding case: the message says so."""
+    from beam_element.fracture import LEVEL_NEIGHBOURHOOD
+
+    sc = scene(shear_loads(scene(peel_loads())), probe_on="bottom", elements=480, core="auto")
+    r = run(sc)
+    tip = beam_tips(sc, r.model)[0]
+    near = r.model.element_levels[tip.node - LEVEL_NEIGHBOURHOOD:tip.node + LEVEL_NEIGHBOURHOOD]
+    assert len(set(near)) > 1  # the situation the warning is about (measured: level 2 patch)
+    assert "core level changes" in r.solution.message and "0_end" in r.solution.message
+    uniform = run(scene(peel_loads(), elements=120))  # core = 1 everywhere: no warning
+    assert "core level changes" not in uniform.solution.message

@@ -1,0 +1,187 @@
+"""Core levels of the beam against the 2D reference: end-of-path load, error, wall time.
+
+Run: ``.venv/bin/python benchmarks/core_levels.py --case fig5 --variants L1 L2 L3 auto``
+(appends rows to ``benchmarks/results/beam/core_levels.csv``) and ``--report`` (writes
+``core_levels.md`` and ``core_levels.png`` from every row).
+
+Cases (scene, target, 2D reference):
+
+- ``bend``: the bonded three-point bend of fig. 4 made linear (w_top_mid = −1 mm); reference the
+  2D model at level ``fine``, solved here (``--reference2d``) and kept in
+  ``core_levels_2d.json``;
+- ``fig4``: fig. 4 to w_top_mid = −12 mm; reference the 2D ``medium`` run of
+  ``benchmarks/results/comparisons/tradeoff.csv`` (its ``fine`` run stopped before −12 mm);
+- ``fig5``: fig. 5 to w_top_mid = −15 mm; reference the 2D ``fine`` run of tradeoff.csv;
+- ``c3``: the c3 cantilever to −40 mm; reference the 2D ``medium`` run, solved here.
+
+Variants: ``L<k>`` every element at level k (``P<k>``: the polynomial family), ``auto`` the
+scene default (error indicator against ``[beam_model] tolerance``). Elements: the scene's
+(240) unless ``--elements``. The machine's load average is recorded with every row.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from beam_element import run  # noqa: E402
+from sandwich.scene import load_scene  # noqa: E402
+
+OUT = ROOT / "benchmarks" / "results" / "beam"
+TRADEOFF = ROOT / "benchmarks" / "results" / "comparisons" / "tradeoff.csv"
+CASES = {
+    "bend": ("paper-fig4-bonded-3pb.toml", -1.0, "linear"),
+    "fig4": ("paper-fig4-bonded-3pb.toml", -12.0, "nonlinear"),
+    "fig5": ("paper-fig5-top-debond-40-load-top.toml", -15.0, "nonlinear"),
+    "c3": ("paper-fig7-cantilever-c3.toml", -40.0, "nonlinear"),
+}
+FIELDS = ["case", "variant", "elements", "dofs", "levels", "estimate", "lambda_end", "reached",
+          "steps", "iterations", "seconds", "load"]
+
+
+def case_scene(case: str):
+    """The case's scene with its target (and linear analysis for ``bend``)."""
+    name, until, kind = CASES[case]
+    scene = load_scene(ROOT / "scenes" / name)
+    a = dataclasses.replace(scene.analysis, kind=kind, until_value=until)
+    return dataclasses.replace(scene, analysis=a)
+
+
+def reference(case: str) -> tuple[float, str]:
+    """2D reference load factor at the case's target and where it comes from."""
+    if case in ("fig4", "fig5"):
+        level = "medium+0" if case == "fig4" else "fine+0"
+        scene = CASES[case][0].removesuffix(".toml")
+        for row in csv.DictReader(open(TRADEOFF)):
+            if row["scene"] == scene and row["model"] == "2d" and row["resolution"] == level:
+                return float(row["final_load_factor"]), f"2D {level.split('+')[0]}, tradeoff.csv"
+        raise SystemExit(f"no 2D {level} row for {scene} in {TRADEOFF}")
+    cached = json.loads((OUT / "core_levels_2d.json").read_text()) if (
+        OUT / "core_levels_2d.json").exists() else {}
+    if case not in cached:
+        raise SystemExit(f"no 2D reference for {case}: run with --reference2d {case}")
+    return cached[case]["lambda_end"], f"2D {cached[case]['level']}, solved here"
+
+
+def solve_reference(case: str) -> None:
+    """Solve the 2D model on the case and cache its end load (fine for bend, medium for c3)."""
+    from reference2d import solve as solve2d
+
+    level = "fine" if case == "bend" else "medium"
+    t = time.perf_counter()
+    sol = solve2d(case_scene(case), level=level)
+    path = OUT / "core_levels_2d.json"
+    cached = json.loads(path.read_text()) if path.exists() else {}
+    cached[case] = {"level": level, "lambda_end": sol.history[-1].load_factor,
+                    "converged": sol.converged, "seconds": time.perf_counter() - t,
+                    "dofs": sol.dofs}
+    path.write_text(json.dumps(cached, indent=2) + "\n")
+    print(case, cached[case], flush=True)
+
+
+def one(case: str, variant: str, elements: int | None) -> dict:
+    scene = case_scene(case)
+    opts: dict = {}
+    if variant != "auto":
+        opts = {"core_level": int(variant[1:]),
+                "core_basis": "polynomial" if variant[0] == "P" else "sublayers"}
+    load = os.getloadavg()[0]
+    t = time.perf_counter()
+    r = run(scene, elements=elements, model_options=opts)
+    seconds = time.perf_counter() - t
+    s = r.solution
+    core = s.extra["core"]
+    counts: dict[int, int] = {}
+    for e in r.model.element_levels:
+        counts[int(e)] = counts.get(int(e), 0) + 1
+    return dict(case=case, variant=variant, elements=r.model.mesh.n_elements, dofs=s.dofs,
+                levels=" ".join(f"L{k}:{v}" for k, v in sorted(counts.items())),
+                estimate=("" if core["estimated_error"] is None
+                          else f"{core['estimated_error']:.4g}"),
+                lambda_end=f"{s.history[-1].load_factor:.6g}", reached=s.converged,
+                steps=len(s.history), iterations=s.extra["total_newton_iterations"],
+                seconds=f"{seconds:.2f}", load=f"{load:.2f}")
+
+
+def report() -> None:
+    rows = list(csv.DictReader(open(OUT / "core_levels.csv")))
+    lines = ["# Beam core levels against the 2D reference (benchmarks/core_levels.py)", "",
+             "err = λ_beam/λ_2D − 1 at the case's target deflection; `estimate` = the beam's own",
+             "indicator (auto); seconds = whole beam solve in one process; load = 1-min load",
+             "average when the run started (the machine has 2 cores: > 2 means shared).", ""]
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = [c for c in CASES if any(r["case"] == c for r in rows)]
+    fig, axes = plt.subplots(1, len(cases), figsize=(4.5 * len(cases), 4), squeeze=False)
+    for ax, case in zip(axes[0], cases, strict=True):
+        try:
+            ref, src = reference(case)
+        except SystemExit as e:
+            lines += [f"## {case}: {e}", ""]
+            continue
+        _, until, kind = CASES[case]
+        lines += [f"## {case} ({kind}, to {until:g} mm): 2D λ = {ref:.6g} ({src})", "",
+                  "| variant | elements | DOFs | levels | estimate | λ | err | reached | steps | "
+                  "s | load |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in rows:
+            if r["case"] != case:
+                continue
+            err = float(r["lambda_end"]) / ref - 1
+            lines.append(f"| {r['variant']} | {r['elements']} | {r['dofs']} | {r['levels']} | "
+                         f"{r['estimate']} | {r['lambda_end']} | {100 * err:+.2f} % | "
+                         f"{r['reached']} | {r['steps']} | {r['seconds']} | {r['load']} |")
+            ax.loglog(float(r["seconds"]), abs(err) + 1e-5,
+                      "o" if r["variant"] != "auto" else "*", ms=10 if r["variant"] == "auto"
+                      else 6)
+            ax.annotate(r["variant"], (float(r["seconds"]), abs(err) + 1e-5), fontsize=7)
+        lines.append("")
+        ax.set(title=case, xlabel="beam wall time (s)", ylabel="|λ/λ_2D − 1|")
+        ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(OUT / "core_levels.png", dpi=110)
+    (OUT / "core_levels.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--case", choices=sorted(CASES), default="fig5")
+    p.add_argument("--variants", nargs="*", default=["L1", "L2", "L3", "L4", "auto"])
+    p.add_argument("--elements", type=int, default=None)
+    p.add_argument("--reference2d", nargs="*", choices=sorted(CASES))
+    p.add_argument("--report", action="store_true")
+    a = p.parse_args()
+    OUT.mkdir(parents=True, exist_ok=True)
+    if a.reference2d:
+        for case in a.reference2d:
+            solve_reference(case)
+        return
+    if a.report:
+        report()
+        return
+    path = OUT / "core_levels.csv"
+    for v in a.variants:
+        row = one(a.case, v, a.elements)
+        new = not path.exists()
+        with open(path, "a", newline="") as f:
+            w = csv.DictWriter(f, FIELDS)
+            if new:
+                w.writeheader()
+            w.writerow(row)
+        print(row, flush=True)
+
+
+if __name__ == "__main__":
+    main()

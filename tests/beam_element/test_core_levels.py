@@ -1,0 +1,206 @@
+"""The core hierarchy: enrichment functions, rules, level 1 = the paper, tangent, transitions.
+
+References: closed-form spans (piecewise cubics, polynomials), exact integrals of piecewise
+polynomials, the level-1 model itself (zero enrichment must reproduce it), central finite
+differences of the internal force, and the nested-space identity of Galerkin solutions.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from beam_scenes import sandwich_scene as three_point_bend
+
+from beam_element.core_basis import MAX_LEVEL, CoreBasis
+from beam_element.core_levels import transfer
+from beam_element.dofs import NODE_DOFS
+from beam_element.model import build_model
+from beam_element.shape_functions import x_shape, z_shape
+from beam_element.solve import linear_solution
+from sandwich.scene import Debond
+
+
+def _hermite_cubic(xi: np.ndarray) -> np.ndarray:
+    """The paper's four z functions (H_b, Hbar_b, H_t, Hbar_t) at ``xi``, shape (4, n)."""
+    return np.array([z_shape(k, xi)[0] for k in ("H_b", "Hbar_b", "H_t", "Hbar_t")])
+
+
+def _span_residual(basis: CoreBasis, level: int, target: np.ndarray, xi: np.ndarray) -> float:
+    A = np.vstack([_hermite_cubic(xi), *[f(xi)[0][None] for f in
+                                          basis.functions[:basis.count(level)]]]).T
+    coef, *_ = np.linalg.lstsq(A, target, rcond=None)
+    return float(np.max(np.abs(A @ coef - target)) / np.max(np.abs(target)))
+
+
+@pytest.mark.parametrize("family", ["sublayers", "polynomial"])
+def test_enrichment_vanishes_with_its_slope_on_the_core_boundaries(family):
+    basis = CoreBasis(family, MAX_LEVEL)
+    for f in basis.functions:
+        v, d = f(np.array([-1.0, 1.0]))
+        assert np.allclose(v, 0.0, atol=1e-14) and np.allclose(d, 0.0, atol=1e-13)
+        ξ = np.linspace(-0.999, 0.999, 301)
+        h = 1e-6
+        fd = (f(ξ + h)[0] - f(ξ - h)[0]) / (2 * h)  # central difference of the value
+        assert np.allclose(fd, f(ξ)[1], atol=1e-6)
+
+
+def test_sublayers_span_every_c1_piecewise_cubic_of_their_partition():
+    rng = np.random.default_rng(3)
+    basis = CoreBasis("sublayers", 4)
+    for level in (2, 3, 4):
+        cuts = basis.partition(level)
+        values, slopes = rng.normal(size=cuts.size), rng.normal(size=cuts.size)
+        ξ = np.linspace(-1, 1, 2001)
+        target = np.zeros_like(ξ)
+        for i in range(cuts.size - 1):  # Hermite interpolation on each sublayer
+            a, b = cuts[i], cuts[i + 1]
+            on = (ξ >= a) & (ξ <= b)
+            t = 2 * (ξ[on] - a) / (b - a) - 1
+            half = (b - a) / 2
+            target[on] = (values[i] * x_shape("H", 0, t)[0] + values[i + 1] * x_shape("H", 1, t)[0]
+                          + half * slopes[i] * x_shape("Hbar", 0, t)[0]
+                          + half * slopes[i + 1] * x_shape("Hbar", 1, t)[0])
+        assert _span_residual(basis, level, target, ξ) < 1e-10
+        # ...and a partition one level finer is not spanned (the hierarchy adds something).
+        finer = CoreBasis("sublayers", level + 1).functions[basis.count(level)]
+        assert _span_residual(basis, level, finer(ξ)[0], ξ) > 1e-3
+
+
+def test_polynomial_levels_span_the_polynomials_of_their_degree():
+    rng = np.random.default_rng(4)
+    basis = CoreBasis("polynomial", 4)
+    ξ = np.linspace(-1, 1, 401)
+    for level in (2, 3, 4):
+        degree = 3 + 2 * (level - 1)
+        p = np.polynomial.Polynomial(rng.normal(size=degree + 1))
+        assert _span_residual(basis, level, p(ξ), ξ) < 1e-10
+        assert _span_residual(basis, level, ξ ** (degree + 1), ξ) > 1e-4
+
+
+@pytest.mark.parametrize("family", ["sublayers", "polynomial"])
+def test_the_core_rule_integrates_its_level_energy_exactly(family):
+    """Sublayers: a random degree-13 polynomial per sublayer; polynomial: degree 4p + 1."""
+    rng = np.random.default_rng(5)
+    basis = CoreBasis(family, 4)
+    for level in (2, 3, 4):
+        ξ, w = basis.rule(level)
+        cuts = basis.partition(level)
+        degree = 13 if family == "sublayers" else 4 * (3 + 2 * (level - 1)) + 1
+        exact = approx = 0.0
+        for i in range(cuts.size - 1):
+            p = np.polynomial.Polynomial(rng.normal(size=degree + 1))
+            P = p.integ()
+            exact += P(cuts[i + 1]) - P(cuts[i])
+            on = (ξ > cuts[i]) & (ξ < cuts[i + 1])
+            approx += float(w[on] @ p(ξ[on]))
+        assert approx == pytest.approx(exact, rel=1e-12, abs=1e-12)
+
+
+def _debonded_bend(elements: int = 12):
+    s = three_point_bend()
+    return dataclasses.replace(s, debonds=(Debond("top", 100.0, 200.0),))
+
+
+def _random_state(model, rng, scale=0.05):
+    u = rng.normal(size=model.size) * scale
+    return u
+
+
+def test_level_1_is_the_paper_element_bit_for_bit():
+    scene = _debonded_bend()
+    rng = np.random.default_rng(6)
+    paper = build_model(scene, elements=12)
+    explicit = build_model(scene, elements=12, core_level=1)
+    u = _random_state(paper, rng)
+    assert explicit.size == paper.size
+    assert np.array_equal(explicit.internal_force(u), paper.internal_force(u))
+    assert (explicit.tangent(u) != paper.tangent(u)).nnz == 0
+
+
+@pytest.mark.parametrize("family", ["sublayers", "polynomial"])
+def test_zero_enrichment_reproduces_the_paper_element(family):
+    """Any levels with all enrichment amplitudes zero: the paper's forces to round-off."""
+    scene = _debonded_bend()
+    rng = np.random.default_rng(7)
+    paper = build_model(scene, elements=12)
+    levels = np.array([1, 2, 3, 3, 2, 1, 1, 4, 4, 2, 1, 3])
+    rich = build_model(scene, elements=12, core_level=levels, core_basis=family)
+    u = _random_state(paper, rng)
+    v = transfer(u, paper, rich)
+    f_rich = rich.internal_force(v)
+    back = transfer(f_rich, rich, paper)  # the paper DOFs' rows (the free numbering differs)
+    f_paper = paper.internal_force(u)
+    assert np.allclose(back, f_paper, rtol=0, atol=1e-9 * np.abs(f_paper).max())
+
+
+@pytest.mark.parametrize("family", ["sublayers", "polynomial"])
+def test_tangent_matches_finite_differences_at_mixed_levels(family):
+    scene = _debonded_bend()
+    rng = np.random.default_rng(8)
+    levels = np.array([1, 2, 3, 3, 2, 1, 1, 3, 3, 2, 1, 2])
+    model = build_model(scene, elements=12, core_level=levels, core_basis=family)
+    u = _random_state(model, rng, 0.2)
+    K = model.tangent(u)
+    for _ in range(3):
+        v = rng.normal(size=model.size)
+        h = 1e-6
+        fd = (model.internal_force(u + h * v) - model.internal_force(u - h * v)) / (2 * h)
+        assert np.linalg.norm(K @ v - fd) <= 1e-6 * np.linalg.norm(fd)
+    assert abs(K - K.T).max() <= 1e-10 * abs(K).max()
+
+
+def test_level_transitions_are_conforming():
+    """The enrichment of a node shared with a lower-level element is fixed at zero, and the
+    core's field at that node is the same seen from both elements."""
+    scene = _debonded_bend()
+    levels = np.array([1] * 4 + [3] * 4 + [2] * 4)
+    model = build_model(scene, elements=12, core_level=levels)
+    n = model.mesh.n_nodes
+    m = (model.dof_map.n_full - NODE_DOFS * n) // n
+    active = (model.dof_map.free[NODE_DOFS * n:].reshape(n, m) >= 0).sum(axis=1)
+    assert active[4] == 0 and active[8] == 4 * CoreBasis("sublayers", 3).count(2)
+    assert active[6] == 4 * CoreBasis("sublayers", 3).count(3)
+    rng = np.random.default_rng(9)
+    u_full = model.expand(rng.normal(size=model.size))
+    from beam_element.fields import sample_layer
+
+    ξ = np.linspace(-1, 1, 9)
+    left = sample_layer(model, "core", u_full, np.ones(9), ξ)
+    right = sample_layer(model, "core", u_full, -np.ones(9), ξ)
+    for k in ("u", "w"):
+        assert np.allclose(getattr(left, k)[:-1], getattr(right, k)[1:], atol=1e-12)
+
+
+def test_linear_stiffness_converges_with_the_level():
+    """Nested spaces: the linear compliance grows monotonically with the level, and the level
+    increments shrink at least geometrically (observed factor ≥ 2 per level)."""
+    scene = three_point_bend()
+    probe = scene.probes[0].name
+    k = []
+    for level in (1, 2, 3, 4):
+        m = build_model(scene, elements=60, core_level=level)
+        u, _ = linear_solution(m, 1.0)
+        k.append(-1.0 / float(m.probe_vector(probe) @ u))
+    steps = -np.diff(k)
+    assert np.all(steps > 0), k
+    assert np.all(steps[1:] <= 0.5 * steps[:-1]), k
+
+
+def test_field_grid_shows_the_sublayers_and_their_levels():
+    from beam_element.fields import core_rows, section_fields
+
+    scene = _debonded_bend()
+    levels = np.array([1] * 4 + [3] * 4 + [2] * 4)
+    model = build_model(scene, elements=12, core_level=levels)
+    rows = core_rows(model, 9)
+    for cut in CoreBasis("sublayers", 3).partition(3):
+        assert np.any(np.isclose(rows, cut))
+    f = section_fields(model, np.zeros(model.size), per_element=2)
+    core_cells = f.region == 0
+    assert set(np.unique(f.core_level[core_cells])) == {1, 2, 3}
+    assert np.all(f.core_level[~core_cells] == 0)
+    # the cells of element 5 (level 3) carry level 3: columns 10, 11 of every core row
+    per_row = 12 * 2
+    assert np.all(f.core_level[:core_cells.sum()].reshape(-1, per_row)[:, 10:12] == 3)
