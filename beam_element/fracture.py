@@ -96,7 +96,7 @@ def level_warning(model: BeamModel, tips: list[BeamTip]) -> str:
             bad.append(f"{t.debond}_{t.tip}")
     if not bad:
         return ""
-    return (f"WARNING: the core level changes within {LEVEL_NEIGHBOURHOOD} elements of debond "
+    return (f"the core level changes within {LEVEL_NEIGHBOURHOOD} elements of debond "
             f"tip(s) {', '.join(bad)}: G there is biased by up to ~10 % (set a uniform "
             "[beam_model] core level or a core_zones entry over the tip; docs/fracture.md)")
 

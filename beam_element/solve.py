@@ -232,6 +232,8 @@ def run(
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(_growth_summary(scene, solution))
+    if level_warning(model, beam_tips(scene, model)):
+        solution.extra["G_warning"] = level_warning(model, beam_tips(scene, model))
     solution.extra["core"] = {
         "how": choice.how, "basis": options["core_basis"],
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,
@@ -386,8 +388,6 @@ def _solution(
     history = []
     max_pen = max_slide = 0.0
     tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
-    if level_warning(model, tips):
-        message += "; " + level_warning(model, tips)
     for s in states:
         summary = model.contact_summary(s.u) if nonlinear else {}
         pen = max((c.max_penetration for c in summary.values()), default=0.0)
