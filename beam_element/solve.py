@@ -15,11 +15,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from beam_element.contact import NORMAL_SIGN
-from beam_element.core_basis import MAX_LEVEL
 from beam_element.core_levels import (
     LevelChoice,
     auto_levels,
     level_counts,
+    lookahead_levels,
     raise_levels,
     state_estimate,
     zone_levels,
@@ -208,7 +208,7 @@ def run(
                 break
             last = states[-1]
             up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
-                             **{**options, "core_level": np.minimum(choice.levels + 1, MAX_LEVEL)})
+                             **{**options, "core_level": lookahead_levels(choice.levels)})
             estimate, shares = state_estimate(model, last.u, last.load_factor, up, a.until_probe)
             choice.passes.append({"stage": f"path step {last.step}",
                                   "elements_per_level": level_counts(choice.levels),

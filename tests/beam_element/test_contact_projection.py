@@ -251,7 +251,8 @@ def test_fig5_converged_states_respect_the_penetration_bound():
     scene = load_scene(FIG5)
     scene = dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
                                                                     until_value=-4.0))
-    result = run(scene, elements=60, model_options={"contact_search": "closest-point"})
+    result = run(scene, elements=60,
+                 model_options={"contact_search": "closest-point", "core_level": 1})
     model = result.model
     assert result.solution.converged, result.solution.message
     assert [p.search for p in model.pairs] == ["closest-point"]
