@@ -177,6 +177,22 @@ class VcctEvaluator:
         self._own_k = np.array([k for k, _ in own], dtype=np.int64)
         self._own_blk = np.array([b for _, b in own], dtype=np.int64)
 
+    def supported_tips(self) -> list[str]:
+        """Tips with a support on a node within Δ ahead (its reaction enters F): ``["0_end"]``.
+
+        The face cells' internal force at a supported node also holds the support's reaction, so
+        G there is not the closure work. Decided over all ranks.
+        """
+        sys = self.model.system
+        fixed = set((sys.bc_dofs // 2).tolist())
+        d = self.model.disc.node_to_block
+        out = []
+        for t in self.tips:
+            local = any(int(n) in d and d[int(n)] in fixed for n in t.ahead)
+            if sys.comm.allreduce(int(local), op=MPI.MAX):
+                out.append(f"{t.debond}_{t.tip}")
+        return out
+
     @property
     def closure_over_element(self) -> float:
         """Smallest Δ / (length of the lip element at a tip): below 1 the estimate is poor.

@@ -125,6 +125,10 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "vcct_closure_over_tip_element": (float(vcct.closure_over_element)
                                           if vcct.tips else None),
     }
+    if vcct.supported_tips():
+        extra["G_warning"] = (f"a support acts within the closure length ahead of tip(s) "
+                              f"{', '.join(vcct.supported_tips())}: its reaction enters the "
+                              "VCCT force, G there is not reliable")
     onset = growth_onset(scene, rows)  # debonds with a toughness: first step G >= G_c
     if onset:
         extra["debond_growth"] = onset

@@ -117,3 +117,16 @@ def test_peel_couple_fine_mesh_independent_of_closure_length():
     exact = peel_g(sc, state[1])
     for dl in (0.5, 1.0, 2.0):
         assert _g(model, state, dl).G == pytest.approx(exact, rel=0.01)
+
+
+def test_a_support_at_the_tip_is_flagged(peel):
+    """A roller on the top face at the tip holds the tip node: its reaction would enter F."""
+    import dataclasses
+
+    from sandwich.scene import Support
+
+    sc = peel[0]
+    assert "G_warning" not in peel[1].extra
+    held = dataclasses.replace(sc, supports=(*sc.supports, Support(60.0, "top", "roller")))
+    sol, _, _ = _solve(held)
+    assert "0_end" in sol.extra["G_warning"]
