@@ -15,8 +15,10 @@ raises the elements that carry the most of it (Dörfler marking) until the estim
 tolerance or every element is at the highest level allowed.
 
 The indicator is evaluated on the linear (small-displacement) step with unilateral contact,
-:func:`beam_element.solve.linear_solution`, and re-checked at the end of a nonlinear path by the
-same identity on the tangent (:func:`state_indicator`).
+:func:`beam_element.solve.linear_solution`. Along a nonlinear path the levels are re-checked on
+the last converged state: :func:`state_shares` says where (a residual indicator, no solve), and
+the path is rerun with those elements raised; the change of the end load between the two runs
+is the estimate (:func:`beam_element.solve.run`).
 """
 
 from __future__ import annotations
@@ -25,8 +27,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from beam_element.core_basis import MAX_LEVEL
 from beam_element.dofs import NODE_DOFS
@@ -34,13 +34,14 @@ from beam_element.mesh import BeamMesh
 from beam_element.model import BeamModel
 
 TIE_TOLERANCE = 1e-6  # relative: shares this close to the Dörfler threshold are marked together
-DORFLER_KEEP = 0.5
+DORFLER_KEEP = 0.5  # mark until the unmarked estimate is below this fraction of the tolerance
 # The indicator compares with the levels raised by LOOKAHEAD. With one level the saturation
 # assumption fails where the level converges slowly (point supports: the error falls by only
 # ~2 per level on a coarse x-mesh) and the estimate was half the true error (linear bend,
 # 60 elements: 0.27 % for a true 0.53 % at level 2); two levels give 0.40 % there and match the
 # truth at level 4 (tests/beam_element/test_core_auto.py).
-LOOKAHEAD = 2  # mark until the unmarked estimate is below this fraction of the tolerance
+LOOKAHEAD = 2
+DORFLER_FRACTION = 0.5  # along a path: raise the elements carrying half the state shares
 
 
 @dataclass
@@ -146,45 +147,41 @@ def linear_estimate(
     return estimate, (η * (estimate / η.sum()) if η.sum() > 0 else η)
 
 
-def state_estimate(
-    cur: BeamModel, u: np.ndarray, load_factor: float, up: BeamModel, probe: str | None
-) -> tuple[float, np.ndarray]:
-    """Relative error of a converged nonlinear state at ``cur``'s levels, and element shares.
+def state_shares(cur: BeamModel, u: np.ndarray, load_factor: float, up: BeamModel) -> np.ndarray:
+    """Where a converged nonlinear state wants more core levels: element shares, shape ``(E,)``.
 
-    One Newton step of the raised model ``up`` from the state (its enrichment amplitudes zero),
-    bordered so that the target probe keeps its value: [K −f; cᵀ 0][δ; Δλ] = [−r; 0] with
-    r = f_int⁺(u) − λ f. Its Δλ/λ is the first-order change of the load at this deflection when
-    the core is raised LOOKAHEAD levels (for a linear problem, the linear estimate). Without
-    a target probe the load is held and the estimate is |δᵀKδ| / |λ fᵀu|. Shares:
-    :func:`element_energies` of δ, scaled to the estimate.
+    The state is carried into the raised model ``up`` (its new enrichment amplitudes zero) and
+    the residual r = f_int⁺ − λ f is read on those new amplitudes: r_j² / K_jj is the energy of
+    the diagonally scaled correction of DOF j (Jacobi), split half and half between the two
+    elements of its node. No solve with K: next to a critical point K is nearly singular and any
+    K⁻¹-based magnitude is meaningless there (a bordered Newton step from fig. 5's state at −5 mm
+    gave 17 %, and Newton in the raised model from that state diverges), while the residual and
+    the diagonal stay well defined. The *magnitude* of the error comes from rerunning the path
+    (:func:`beam_element.solve.run`).
     """
     v = transfer(u, cur, up)
-    K = up.tangent(v)
     r = up.internal_force(v) - load_factor * up.f_ref
-    if probe is not None:
-        c = up.probe_vector(probe)
-        A = sp.bmat([[K, -up.f_ref[:, None]], [c[None, :], None]], format="csc")
-        sol = spla.splu(A).solve(np.concatenate([-r, [0.0]]))
-        δ, dλ = sol[:-1], float(sol[-1])
-        estimate = abs(dλ) / max(abs(load_factor), np.finfo(float).tiny)
-    else:
-        δ = spla.splu(sp.csc_matrix(K)).solve(-r)
-        estimate = abs(float(δ @ (K @ δ))) / max(abs(load_factor * float(up.f_ref @ v)),
-                                                 np.finfo(float).tiny)
-    if not np.isfinite(estimate):
-        raise ValueError("the core error indicator is not finite at this state")
-    blocks = up.full_response(up.expand(v))[1]
-    η = np.abs(element_energies(up, blocks, up.expand(δ)))
-    return estimate, (η * (estimate / η.sum()) if η.sum() > 0 else η)
+    diag = up.tangent(v).diagonal()
+    n = up.mesh.n_nodes
+    m_up = (up.dof_map.n_full - NODE_DOFS * n) // n
+    m_cur = (cur.dof_map.n_full - NODE_DOFS * n) // n
+    free = up.dof_map.free[NODE_DOFS * n:].reshape(n, m_up)
+    held = np.zeros((n, m_up), dtype=bool)  # the amplitudes cur already had at each node
+    held[:, :m_cur] = cur.dof_map.free[NODE_DOFS * n:].reshape(n, m_cur) >= 0
+    new = (free >= 0) & ~held
+    node = np.zeros(n)
+    rows, js = np.nonzero(new)
+    k = free[rows, js]
+    np.add.at(node, rows, r[k] ** 2 / np.maximum(np.abs(diag[k]), np.finfo(float).tiny))
+    return 0.5 * (node[:-1] + node[1:])
 
 
 def raise_levels(
-    levels: np.ndarray, shares: np.ndarray, estimate: float, tolerance: float, max_level: int
+    levels: np.ndarray, shares: np.ndarray, excess: float, max_level: int
 ) -> np.ndarray:
-    """Raise by one the elements carrying most of ``estimate`` (Dörfler), below ``max_level``."""
+    """Raise by one the elements carrying ``excess`` of the shares (Dörfler), up to max_level."""
     raisable = levels < max_level
     share = np.where(raisable, shares, 0.0)
-    excess = estimate - DORFLER_KEEP * tolerance
     marked = dorfler(share, min(excess, share.sum()))
     return np.where(marked & raisable, levels + 1, levels)
 
@@ -226,7 +223,7 @@ def auto_levels(
                        "estimate": estimate})
         if estimate <= tolerance or not np.any(levels < max_level):
             return LevelChoice(levels=levels, how="auto", estimate=estimate, passes=passes)
-        levels = raise_levels(levels, shares, estimate, tolerance, max_level)
+        levels = raise_levels(levels, shares, estimate - DORFLER_KEEP * tolerance, max_level)
         cur = build(levels)
         u = solve_linear(cur)
 

@@ -16,12 +16,13 @@ import scipy.sparse as sp
 
 from beam_element.contact import NORMAL_SIGN
 from beam_element.core_levels import (
+    DORFLER_FRACTION,
     LevelChoice,
     auto_levels,
     level_counts,
     lookahead_levels,
     raise_levels,
-    state_estimate,
+    state_shares,
     zone_levels,
 )
 from beam_element.fields import profile_columns, section_fields
@@ -44,9 +45,10 @@ DESIRED_ITERATIONS = 8
 # meets the bound at every resolution.
 PENALTY_RESTARTS = 2
 PENALTY_GROWTH = 2.0
-# "auto" core levels: at the end of the path the indicator is re-evaluated on the converged state
-# (beam_element.core_levels.state_estimate); above the tolerance the levels are raised where it
-# points and the path is rerun, at most CORE_RECHECKS times.
+# "auto" core levels along a path: the last converged state says where the core wants more
+# levels (beam_element.core_levels.state_shares); the path is rerun with those raised and the
+# change of the end load is the estimate; reruns continue while it exceeds the tolerance, at most
+# CORE_RECHECKS times.
 CORE_RECHECKS = 3
 
 
@@ -201,34 +203,44 @@ def run(
         states, message = _linear_states(model, scene)
         converged = True
     else:
+        previous: ConvergedState | None = None
         for recheck in range(CORE_RECHECKS + 1):
             model, states, message, converged, limit_points, raised = _follow_penalised(
                 scene, elements, {**options, "core_level": choice.levels}, progress)
-            if choice.how != "auto" or states[-1].load_factor == 0.0:
-                break
             last = states[-1]
-            up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
-                             **{**options, "core_level": lookahead_levels(choice.levels)})
-            estimate, shares = state_estimate(model, last.u, last.load_factor, up, a.until_probe)
+            if choice.how != "auto" or last.load_factor == 0.0:
+                break
+            if previous is not None:  # the change the last raise made is the estimate
+                choice.estimate = (abs(last.load_factor - previous.load_factor)
+                                   / abs(last.load_factor) if converged else None)
             choice.passes.append({"stage": f"path step {last.step}",
                                   "elements_per_level": level_counts(choice.levels),
-                                  "estimate": estimate})
-            choice.estimate = estimate
+                                  "load_factor": last.load_factor, "reached": converged,
+                                  "estimate": choice.estimate if previous is not None else None})
             tol, top = float(bm.tolerance), int(bm.max_core_level)
-            if estimate <= tol or not np.any(choice.levels < top) or recheck == CORE_RECHECKS:
+            if not converged or not np.any(choice.levels < top) or recheck == CORE_RECHECKS or (
+                    choice.estimate is not None and previous is not None
+                    and choice.estimate <= tol):
                 break
-            choice.levels = raise_levels(choice.levels, shares, estimate, tol, top)
+            up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                             **{**options, "core_level": lookahead_levels(choice.levels)})
+            shares = state_shares(model, last.u, last.load_factor, up)
+            choice.levels = raise_levels(choice.levels, shares, DORFLER_FRACTION * shares.sum(),
+                                         top)
+            previous = last
             if progress is not None:
-                progress(CoreRecheck(estimate, level_counts(choice.levels)))
+                progress(CoreRecheck(level_counts(choice.levels)))
         if raised:
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
-        if choice.how == "auto" and choice.estimate is not None and \
-                choice.estimate > float(bm.tolerance):
-            message += (f"; WARNING: the core's estimated error {100 * choice.estimate:.2g} % "
-                        f"exceeds the tolerance {100 * float(bm.tolerance):.2g} % at "
-                        f"max_core_level {bm.max_core_level}")
+        if choice.how == "auto" and converged and (
+                choice.estimate is None or choice.estimate > float(bm.tolerance)):
+            said = ("could not be estimated" if choice.estimate is None else
+                    f"{100 * choice.estimate:.2g} % exceeds the tolerance "
+                    f"{100 * float(bm.tolerance):.2g} %")
+            message += (f"; WARNING: the core's estimated error {said} (max_core_level "
+                        f"{bm.max_core_level}, {CORE_RECHECKS} reruns)")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(_growth_summary(scene, solution))
@@ -303,7 +315,6 @@ def _load_sign(model: BeamModel, scene: object) -> float:
 class CoreRecheck:
     """Progress event: the path is rerun with raised core levels (the bar restarts)."""
 
-    estimate: float
     elements_per_level: dict[str, int]
     step: int = 0
     load_factor: float = 0.0
@@ -311,8 +322,8 @@ class CoreRecheck:
     @property
     def message(self) -> str:
         """What a user is told."""
-        return (f"core error estimate {100 * self.estimate:.2g} % above tolerance: rerunning "
-                f"the path with elements per core level {self.elements_per_level}")
+        return ("checking the core levels: rerunning the path with elements per core level "
+                f"{self.elements_per_level}")
 
 
 def _follow_penalised(

@@ -1,23 +1,28 @@
 """Cross-validation: the beam model against the 2D reference on three scenes (CI).
 
-Runs both real models: the beam at its scene default (240 graded elements, the paper's element)
-and the 2D reference at level "coarse" (within 1 % of level "medium" on these quantities, see
-docs/reference2d.md). Reference: the 2D model.
+Runs both real models: the beam at its scene default (240 graded elements, core levels "auto"
+at tolerance 1 %, docs/beam_element.md "Core levels") and the 2D reference at level "coarse"
+(within 1 % of level "medium" on these quantities, see docs/reference2d.md). Reference: the 2D
+model.
 
 Tolerances, and why (3 %, 5 % and 25 % were written before either model existed, from the
-issue's "a few percent" and "looser, stated"; none was loosened):
+issue's "a few percent" and "looser, stated"; none was loosened). With the core hierarchy they
+were tightened to the measured agreement (2026-12-01, auto against 2D coarse: load L2 0.57 %,
+0.78 %, 0.57 % and max 0.67 %, 0.83 %, 0.62 % on fig4, fig5, c2; window-averaged stress
+extremes within 16 % of the 2D's largest magnitude):
 
-- load-deflection curve, relative L2 over the common range ≤ 3 %, max ≤ 5 %.
+- load-deflection curve, relative L2 over the common range ≤ 1 %, max ≤ 1.5 % (was 3 %, 5 %
+  with the paper's element alone, which was 2.1 %, 2.5 % and 0.6 % off in L2).
 - interface σzz (top, bottom) and core τ: the profiles are averaged over a 5 mm window first,
   because at crack tips and where a clamped or pinned face sits on the free core the 2D stress is
   singular (its raw peak grows under refinement, see tests/comparisons/test_cmp_window.py), while
   the window average converges. The smallest and largest averaged values of each model must lie
-  within 25 % of the 2D's largest magnitude.
+  within 20 % of the 2D's largest magnitude (was 25 %).
 
 What changed after the first runs, and is said here: the fig5 case first ran to w = −5 mm and
-failed; it now runs to −2 mm (before the debonded face buckles) and the −5 mm run is kept as a
-strict xfail (it fails loudly if the gap closes): past that buckling the 2D model softens and the
-converged beam stays about 7 % stiffer at w = −5 mm (docs/beam_vs_2d.md). Stress peaks were
+failed; it runs to −2 mm (before the debonded face buckles), and the −5 mm run, a strict xfail
+while the paper's element alone stayed about 7 % stiffer there (docs/beam_vs_2d.md), is a test
+again since the core hierarchy closed the gap to 1-1.5 %. Stress peaks were
 first compared raw, which is meaningless at the singular points named above.
 """
 
@@ -36,8 +41,8 @@ pytestmark = pytest.mark.dolfinx
 
 ROOT = Path(__file__).resolve().parents[2]
 REF_LEVEL = "coarse"
-LOAD_L2, LOAD_MAX = 0.03, 0.05
-STRESS_TOL = 0.25
+LOAD_L2, LOAD_MAX = 0.01, 0.015
+STRESS_TOL = 0.20
 WINDOW = 5.0  # mm
 STRESSES = ("sigma_zz_top", "sigma_zz_bottom", "tau_core")
 
@@ -92,7 +97,11 @@ def test_beam_agrees_with_2d(tmp_path, name, until):
         assert abs(b.max() - r.max()) <= STRESS_TOL * scale, (col, b.max(), r.max(), scale)
 
 
-@pytest.mark.xfail(strict=True, reason="known gap: past the debonded face's buckling the "
-                   "converged beam is ~7 % stiffer than 2D at w = -5 mm (docs/beam_vs_2d.md)")
 def test_fig5_beyond_face_buckling(tmp_path):
-    _load_curve_agrees(_compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0))
+    """Past the debonded face's buckling (w = −5 mm): the paper's element alone was ~7 % too
+    stiff here (a strict xfail until the core hierarchy); with auto core levels it is within
+    the original 3 %/5 % (measured 2026-12-01: L2 1.0 %, max 1.5 % against 2D coarse)."""
+    cmp = _compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0)
+    load = cmp.metrics.curve("load_factor")
+    assert load is not None and load.l2_relative is not None, cmp.metrics.notes
+    assert load.l2_relative <= 0.03 and load.max_relative <= 0.05, load
