@@ -3,10 +3,11 @@
 G of a crack extension by the closure length Δ (a physical length, mm, kept fixed while the mesh
 changes) is the work needed to close the crack again over Δ:
 
-    G(Δ) = 1/(2 b Δ) ∫_0^Δ t(s) · δ(Δ − s) ds
+    G(Δ) = −1/(2 Δ) ∫_0^Δ t(s) · δ(Δ − s) ds
 
-with t the interface traction at the distance s ahead of the tip and δ(r) = u_face − u_core the
-opening of the lips at the distance r behind it. Discretely (Raju's VCCT for quadratic elements
+with t the traction (MPa) that the core exerts on the face at the distance s ahead of the tip and
+δ(r) = u_face − u_core the opening of the lips at the distance r behind it (t · δ < 0 where the
+core holds the face back). Discretely (Raju's VCCT for quadratic elements
 generalised to a closure length of several elements): t is represented by the consistent nodal
 forces F_k of the interface nodes ahead of the tip within Δ, the forces that the core exerts on
 the face there, i.e. the face cells' internal force at those nodes (the face is free of
