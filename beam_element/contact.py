@@ -3,12 +3,12 @@
 Pairing. Nodes strictly inside a debond are untied; at each of them the face's inner surface
 point (master) meets the core's boundary curve (slave). Two searches (``contact_pairs(search=)``):
 
-* ``"closest-point"`` (the default of ``contact_search`` in
-  :func:`beam_element.model.build_model`, docs/contact_search.md): node-to-segment. The master
+* ``"closest-point"`` (option of ``contact_search`` in :func:`beam_element.model.build_model`,
+  docs/contact_search.md): node-to-segment. The master
   point is projected on the deformed core boundary curve, the gap is measured along the slave's
   deformed normal at the projection, and the linearisation includes the motion of the
   projection point (below).
-* ``"same-x"`` (option; the model's earlier default, and the default of :func:`contact_pairs`):
+* ``"same-x"`` (the default of ``build_model`` and of :func:`contact_pairs`):
   node-to-node, the core boundary point of the *same material coordinate x*. It assumes small
   relative sliding; the sliding s = t·Δ is returned so a user can check it.
 

@@ -41,8 +41,8 @@ from beam_element.layer_operators import (
 from beam_element.loads import patch_load, point_load, probe_row
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
+from sandwich.scene import FACE_MEMBRANES, GRADINGS, BeamModelOptions
 
-GRADINGS = ("graded", "tips", "uniform")
 CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
 PENALTY_FACTOR = 1e4  # default contact penalty ε = PENALTY_FACTOR · Q_z / h_c  (N/mm³)
 PENETRATION_BOUND = 1e-3  # allowed penetration / face thickness
@@ -402,11 +402,11 @@ def build_model(
     core_basis
         Enrichment family of levels > 1: ``"sublayers"`` (default) or ``"polynomial"``.
     """
-    if face_membrane not in ("paper", "averaged"):
-        raise ValueError(f"face_membrane must be 'paper' or 'averaged', got {face_membrane!r}")
+    if face_membrane not in FACE_MEMBRANES:
+        raise ValueError(f"face_membrane must be one of {FACE_MEMBRANES}, got {face_membrane!r}")
     options = getattr(scene, "beam_model", None)
     if elements is None:
-        elements = getattr(options, "elements", 120)
+        elements = getattr(options, "elements", BeamModelOptions.elements)
     mesh = beam_mesh(scene, elements, grading=grading, growth=growth, size_ratio=size_ratio)
     if not (np.isfinite(scene.width) and scene.width > 0):
         raise ValueError(f"beam width must be positive, got {scene.width!r}")

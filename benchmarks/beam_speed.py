@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from beam_element import build_model, run  # noqa: E402
-from sandwich.scene import load_scene  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "beam"
 SCENE = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"

@@ -23,7 +23,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from sandwich.scene import Scene, load_scene  # noqa: E402
+from sandwich.scene import Scene  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "comparisons"
 WIDTHS = (300.0, 40.0, 20.0, 10.0, 5.0, 2.5)

@@ -36,7 +36,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from sandwich.results import Solution  # noqa: E402
-from sandwich.scene import Load, Scene, load_scene  # noqa: E402
+from sandwich.scene import Load, Scene  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "comparisons"
 OPEN_P = 1e-5  # MPa: a station with less contact pressure than this is contact-free

@@ -16,7 +16,7 @@ import numpy as np
 
 import beam_element
 import reference2d
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 path, until = sys.argv[1], float(sys.argv[2])
 n = int(sys.argv[3]) if len(sys.argv) > 3 else 240

@@ -11,7 +11,8 @@ import sys
 
 import beam_element
 import reference2d
-from sandwich.scene import Probe, load_scene
+from sandwich.scene import Probe
+from sandwich.scene_file import load_scene
 
 s = load_scene(sys.argv[1])
 n = int(sys.argv[2]) if len(sys.argv) > 2 else 240

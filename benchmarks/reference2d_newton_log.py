@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from reference2d import solve
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "reference2d"

@@ -70,7 +70,7 @@ def run(name: str, level: str, full: bool, until: float = UNTIL) -> dict:
 
     from reference2d import contact as ct
     from reference2d import solve
-    from sandwich.scene import load_scene
+    from sandwich.scene_file import load_scene
 
     scene = load_scene(ROOT / "scenes" / f"{name}.toml")
     if not full:

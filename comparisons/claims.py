@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from comparisons.compare import Comparison
+from comparisons.pair import BEAM, REFERENCE
 from comparisons.paths import LOAD, Curve, curve_error, path_curve, series
-from comparisons.runs import BEAM, REFERENCE
 
 REPRODUCED, NOT_REPRODUCED, NOT_CHECKED = "reproduced", "not reproduced", "not checked"
 BOTH = "beam vs 2d"

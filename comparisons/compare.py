@@ -12,17 +12,17 @@ from pathlib import Path
 
 import numpy as np
 
-from comparisons.deformed import draw_face_lines, render_snapshot
+from comparisons.deformed import draw_face_lines, render_frame
+from comparisons.face_lines import face_lines
 from comparisons.metrics import Metrics, compute_metrics
+from comparisons.pair import BEAM, PAIR, REFERENCE
 from comparisons.paths import LOAD, Curve, limit_loads, path_parameter, series
 from comparisons.plots import Panel, overlay
 from comparisons.profiles import ChosenProfile, choose_common
-from comparisons.runs import BEAM, MODELS, REFERENCE, ModelRun, Progress, Solver, obtain
-from comparisons.snapshots import face_lines, snapshot_of
+from models import ModelRun, Progress, Solver, obtain
 from sandwich.results import Solution, atomic_write_text
-from sandwich.scene import Scene, load_scene
-
-DEFAULT_RESULTS = Path("results")
+from sandwich.scene import Scene
+from sandwich.scene_file import load_scene
 
 
 @dataclass
@@ -46,6 +46,17 @@ class Comparison:
     def missing(self) -> dict[str, str]:
         """Models without a solution, with the reason."""
         return {m: r.reason for m, r in self.runs.items() if r.solution is None}
+
+
+def model_folder(scene: Scene, model: str, out_dir: Path,
+                 results_root: str | Path | None = None) -> Path:
+    """Where ``model``'s result of ``scene`` lives.
+
+    ``<results_root>/<scene>/<model>/``, or ``<out_dir>/<model>/`` without a results root.
+    """
+    if results_root is None:
+        return Path(out_dir) / model
+    return Path(results_root) / scene.name / model
 
 
 def total_force(scene: Scene) -> float:
@@ -129,9 +140,9 @@ def _deformed_figures(cmp: Comparison) -> None:
         run = cmp.runs.get(model)
         if run is None or run.solution is None:
             continue
-        snap = snapshot_of(run.solution, run.folder)
-        if snap is not None:
-            cmp.figures.append(render_snapshot(snap, cmp.out_dir / f"deformed_{model}.png"))
+        if run.solution.fields:
+            frame = max(run.solution.fields, key=lambda f: f.step)
+            cmp.figures.append(render_frame(model, frame, cmp.out_dir / f"deformed_{model}.png"))
         elif model in cmp.chosen_profiles:
             c = cmp.chosen_profiles[model]
             lines.append(face_lines(cmp.scene, c.profile, model))
@@ -142,7 +153,7 @@ def _deformed_figures(cmp: Comparison) -> None:
 
 
 def compare(scene: Scene | str | Path, out_dir: str | Path, *, reuse: bool = True,
-            progress: Progress | None = None, results_root: str | Path = DEFAULT_RESULTS,
+            progress: Progress | None = None, results_root: str | Path | None = None,
             solvers: Mapping[str, Solver] | None = None) -> Comparison:
     """Run (or reuse) both models on ``scene`` and write the comparison into ``out_dir``.
 
@@ -153,11 +164,13 @@ def compare(scene: Scene | str | Path, out_dir: str | Path, *, reuse: bool = Tru
     out_dir
         Folder for figures (PNG + CSV each), deformed pictures and ``metrics.json``.
     reuse
-        Reuse a model's result folder when it is fresh (newer than scene and sources).
+        Reuse a model's result folder when the identity it records (scene content, the
+        model's options and resolution, code) is the one asked now; else solve again.
     progress
-        Receives a :class:`~comparisons.runs.ProgressEvent` per phase and converged step.
+        Receives a :class:`~models.ProgressEvent` per phase and converged step.
     results_root
-        Root of the models' result folders (``<root>/<scene>/<model>/``).
+        Root of the models' result folders (``<root>/<scene>/<model>/``); ``None``: inside
+        ``out_dir`` (``<out_dir>/<model>/``), so that nothing is written outside it.
     solvers
         Replacement ``solve`` callables by model name (tests, benchmarks).
 
@@ -172,8 +185,8 @@ def compare(scene: Scene | str | Path, out_dir: str | Path, *, reuse: bool = Tru
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     solvers = dict(solvers or {})
-    runs = {m: obtain(scene, m, results_root=Path(results_root), reuse=reuse, progress=progress,
-                      solver=solvers.get(m)) for m in MODELS}
+    runs = {m: obtain(scene, m, model_folder(scene, m, out_dir, results_root), reuse=reuse,
+                      progress=progress, solver=solvers.get(m)) for m in PAIR}
     present = [r.solution for r in runs.values() if r.solution is not None and r.solution.history]
     abscissa = path_parameter(scene.analysis.until_probe, present)
     metrics = compute_metrics(scene.name, runs, abscissa)

@@ -1,9 +1,14 @@
-"""Deformed-configuration pictures, from 2D fields or from face profiles.
+"""Deformed-configuration pictures, from a model's field frame or from face profiles.
 
-pyvista (off screen) from a :class:`FieldSnapshot`, or matplotlib face lines from profiles when
-no model gave 2D fields.
+Both models fill the one field type :class:`~sandwich.results.FieldFrame` (points, cells,
+displacement, point or cell data): the picture of a model is its last frame, drawn deformed and
+coloured by the von Mises stress the model computed (the beam: per point, second Piola-Kirchhoff;
+the 2D reference: per cell, Cauchy), faces grey (cell data ``region``: 0 core, 1 top face,
+2 bottom face). pyvista renders off screen in a child process, matplotlib when that fails.
+Without frames, the pictures fall back to the face lines of the profiles
+(:mod:`comparisons.face_lines`).
 
-Drawing only: the von Mises stress comes from the model; deformation is drawn at true scale.
+Drawing only: stresses come from the model; deformation is drawn at true scale.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ import subprocess
 import sys
 import tempfile
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -20,87 +26,139 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from comparisons.snapshots import FaceLines, FieldSnapshot, save_snapshot  # noqa: E402
+from comparisons.face_lines import FaceLines  # noqa: E402
+from sandwich.results import FieldFrame, Solution  # noqa: E402
+from sandwich.results.vtu import read_vtu, vtu_text  # noqa: E402
+
+STRESS = "von_mises"
 
 
-def render_snapshot(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0) -> Path:
-    """Render ``snapshot`` deformed (× ``scale``), coloured by core von Mises, into ``path``.
+@dataclass(frozen=True)
+class Picture:
+    """What one deformed picture shows: a model's frame reduced to the drawn arrays."""
 
-    pyvista renders in a child process: VTK's wheel and the FEniCSx stack loaded in one process
-    have been seen to abort inside VTK (a C++ library clash). If the child fails, the picture is
-    drawn with matplotlib instead, and the title says so.
+    model: str
+    step: int
+    load_factor: float
+    points: np.ndarray  # (n, 2) reference (x, z), mm
+    displacement: np.ndarray  # (n, 2), mm
+    cells: np.ndarray  # (m, 3 | 4)
+    von_mises: np.ndarray  # (m,) per cell or (n,) per point, MPa
+    per_cell: bool
+    region: np.ndarray  # (m,) 0 core, 1 top face, 2 bottom face
+
+
+def picture_of(model: str, frame: FieldFrame) -> Picture:
+    """The picture data of ``frame``; ``ValueError`` if it holds no von Mises stress."""
+    if STRESS in frame.cell_data:
+        vm, per_cell = np.asarray(frame.cell_data[STRESS], dtype=float), True
+    elif STRESS in frame.point_data:
+        vm, per_cell = np.asarray(frame.point_data[STRESS], dtype=float), False
+    else:
+        raise ValueError(f"{model}: field frame of step {frame.step} has no {STRESS}")
+    cells = np.asarray(frame.cells, dtype=np.int64)
+    region = np.asarray(frame.cell_data.get("region", np.zeros(len(cells))), dtype=int)
+    return Picture(model, int(frame.step), float(frame.load_factor),
+                   np.asarray(frame.points, dtype=float)[:, :2],
+                   np.asarray(frame.displacement, dtype=float)[:, :2], cells, vm, per_cell,
+                   region)
+
+
+def last_picture(solution: Solution) -> Picture | None:
+    """The picture of the solution's last field frame, ``None`` when it has no frames."""
+    if not solution.fields:
+        return None
+    frame = max(solution.fields, key=lambda f: f.step)
+    return picture_of(solution.model, frame)
+
+
+def render_frame(model: str, frame: FieldFrame, path: Path, *, scale: float = 1.0) -> Path:
+    """Render ``frame`` deformed (× ``scale``), coloured by core von Mises, into ``path``.
+
+    pyvista renders in a child process (the frame handed over as VTU): VTK's wheel and the
+    FEniCSx stack loaded in one process have been seen to abort inside VTK (a C++ library
+    clash). If the child fails, the picture is drawn with matplotlib instead, and the title says
+    so.
     """
+    pic = picture_of(model, frame)
     with tempfile.TemporaryDirectory() as tmp:
-        npz = save_snapshot(snapshot, Path(tmp))
-        cmd = [sys.executable, "-m", "comparisons.render_worker", str(npz), str(path),
-               snapshot.model, repr(scale)]
+        vtu = Path(tmp) / "frame.vtu"
+        vtu.write_text(vtu_text(pic.points, pic.cells, {"displacement": pic.displacement,
+                                                        **({} if pic.per_cell else
+                                                           {STRESS: pic.von_mises})},
+                                {"region": pic.region.astype(float),
+                                 **({STRESS: pic.von_mises} if pic.per_cell else {})}))
+        cmd = [sys.executable, "-m", "comparisons.render_worker", str(vtu), str(path), model,
+               str(pic.step), repr(pic.load_factor), repr(scale)]
         try:
             done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
             ok = done.returncode == 0 and Path(path).is_file()
         except (OSError, subprocess.TimeoutExpired):
             ok = False
-    return path if ok else draw_snapshot(snapshot, path, scale=scale, note="pyvista failed; ")
+    return path if ok else draw_picture(pic, path, scale=scale, note="pyvista failed; ")
 
 
-def draw_snapshot(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0,
-                  note: str = "") -> Path:
+def picture_from_vtu(path: Path, model: str, step: int, load_factor: float) -> Picture:
+    """The picture written by :func:`render_frame` for its child process."""
+    points, cells, point_data, cell_data = read_vtu(path)
+    frame = FieldFrame(step, load_factor, points[:, :2], cells,
+                       point_data.pop("displacement")[:, :2], point_data, cell_data)
+    return picture_of(model, frame)
+
+
+def draw_picture(pic: Picture, path: Path, *, scale: float = 1.0, note: str = "") -> Path:
     """Matplotlib picture of the deformed section, core cells coloured by von Mises."""
     from matplotlib.collections import PolyCollection
 
-    xz = snapshot.points + scale * snapshot.displacement
-    vm = np.asarray(snapshot.von_mises, dtype=float)
-    if not snapshot.per_cell:
-        vm = vm[snapshot.cells].mean(axis=1)
-    region = snapshot.region if snapshot.region is not None else np.zeros(len(vm), dtype=int)
+    xz = pic.points + scale * pic.displacement
+    vm = pic.von_mises if pic.per_cell else pic.von_mises[pic.cells].mean(axis=1)
     fig, ax = plt.subplots(figsize=(14, 3.6))
-    core = region == 0
-    polys = PolyCollection(xz[snapshot.cells[core]], array=vm[core], cmap="viridis",
+    core = pic.region == 0
+    polys = PolyCollection(xz[pic.cells[core]], array=vm[core], cmap="viridis",
                            edgecolors="none")
     ax.add_collection(polys)
-    ax.add_collection(PolyCollection(xz[snapshot.cells[~core]], facecolors="gray",
+    ax.add_collection(PolyCollection(xz[pic.cells[~core]], facecolors="gray",
                                      edgecolors="none"))
     fig.colorbar(polys, ax=ax, label="core von Mises (MPa)", fraction=0.03)
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("z (mm)")
-    ax.set_title(f"{note}{snapshot.model}: step {snapshot.step}, "
-                 f"load factor {snapshot.load_factor:.4g}", fontsize=9)
+    ax.set_title(f"{note}{pic.model}: step {pic.step}, load factor {pic.load_factor:.4g}",
+                 fontsize=9)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
 
-def render_with_pyvista(snapshot: FieldSnapshot, path: Path, *, scale: float = 1.0,
+def render_with_pyvista(pic: Picture, path: Path, *, scale: float = 1.0,
                         window: tuple[int, int] = (1600, 420)) -> Path:
-    """Render in this process with pyvista (off screen); see :func:`render_snapshot`."""
+    """Render in this process with pyvista (off screen); see :func:`render_frame`."""
     import pyvista as pv
 
     pv.OFF_SCREEN = True
-    xz = snapshot.points + scale * snapshot.displacement
+    xz = pic.points + scale * pic.displacement
     pts = np.column_stack([xz[:, 0], np.zeros(len(xz)), xz[:, 1]])
-    k = snapshot.cells.shape[1]
+    k = pic.cells.shape[1]
     kind = pv.CellType.TRIANGLE if k == 3 else pv.CellType.QUAD
-    conn = np.column_stack([np.full(len(snapshot.cells), k), snapshot.cells]).ravel()
-    grid = pv.UnstructuredGrid(conn, np.full(len(snapshot.cells), kind, dtype=np.uint8), pts)
+    conn = np.column_stack([np.full(len(pic.cells), k), pic.cells]).ravel()
+    grid = pv.UnstructuredGrid(conn, np.full(len(pic.cells), kind, dtype=np.uint8), pts)
     name = "von Mises (MPa)"
-    if snapshot.per_cell:
-        grid.cell_data[name] = np.asarray(snapshot.von_mises, dtype=float)
+    if pic.per_cell:
+        grid.cell_data[name] = pic.von_mises
     else:
-        grid.point_data[name] = np.asarray(snapshot.von_mises, dtype=float)
+        grid.point_data[name] = pic.von_mises
     plotter = pv.Plotter(off_screen=True, window_size=list(window))
     plotter.set_background("white")
-    if snapshot.region is not None:
-        core = grid.extract_cells(np.flatnonzero(snapshot.region == 0))
-        faces = grid.extract_cells(np.flatnonzero(snapshot.region != 0))
-        if faces.n_cells:
-            plotter.add_mesh(faces, color="gray")
-        grid = core
-    plotter.add_mesh(grid, scalars=name, cmap="viridis",
+    core = grid.extract_cells(np.flatnonzero(pic.region == 0))
+    faces = grid.extract_cells(np.flatnonzero(pic.region != 0))
+    if faces.n_cells:
+        plotter.add_mesh(faces, color="gray")
+    plotter.add_mesh(core, scalars=name, cmap="viridis",
                      scalar_bar_args={"title": name, "color": "black"})
-    plotter.add_text(f"{snapshot.model}: step {snapshot.step}, "
-                     f"load factor {snapshot.load_factor:.4g}", font_size=10, color="black")
+    plotter.add_text(f"{pic.model}: step {pic.step}, load factor {pic.load_factor:.4g}",
+                     font_size=10, color="black")
     plotter.view_xz()
     plotter.enable_parallel_projection()
     span_x = float(np.ptp(xz[:, 0])) or 1.0

@@ -11,10 +11,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from comparisons.claims import ClaimResult, check_claims
-from comparisons.compare import DEFAULT_RESULTS, Comparison, compare
-from comparisons.runs import PROJECT_ROOT, Progress, Solver
+from comparisons.compare import Comparison, compare
+from models import PROJECT_ROOT, Progress, Solver
 from sandwich.results import atomic_write_text
-from sandwich.scene import Scene, load_scene
+from sandwich.scene import Scene
+from sandwich.scene_file import load_scene
 
 
 @dataclass
@@ -29,6 +30,11 @@ class Gallery:
 def shipped_scenes(root: Path = PROJECT_ROOT) -> list[Path]:
     """The shipped paper-like scene files, ``scenes/paper-*.toml``, sorted."""
     return sorted((root / "scenes").glob("paper-*.toml"))
+
+
+def _cell(text: str) -> str:
+    """Text for a Markdown table cell: one line, no column separator."""
+    return " ".join(str(text).split()).replace("|", "/")
 
 
 def _pct(v: float | None) -> str:
@@ -48,7 +54,7 @@ def scene_section(cmp: Comparison, report_dir: Path) -> list[str]:
     for name, s in m.models.items():
         lims = ", ".join(f"{ll.load_factor:.4g}" for ll in s.limit_loads) or "none"
         if s.origin in ("missing", "failed"):
-            lines.append(f"| {name} | {s.origin}: {s.reason} | — | — | — | — | — | — |")
+            lines.append(f"| {name} | {s.origin}: {_cell(s.reason)} | — | — | — | — | — | — |")
         else:
             lines.append(f"| {name} | {s.origin} | {s.converged} | {s.steps} | "
                          f"{_num(s.final_load_factor)} | {lims} | {_num(s.wall_seconds, '.3g')}"
@@ -107,7 +113,7 @@ def write_report(comparisons: Mapping[str, Comparison], claims: Sequence[ClaimRe
 
 def gallery(scenes: Sequence[Scene | str | Path] | None, out_dir: str | Path, *,
             reuse: bool = True, progress: Progress | None = None,
-            results_root: str | Path = DEFAULT_RESULTS,
+            results_root: str | Path | None = None,
             solvers: Mapping[str, Solver] | None = None) -> Gallery:
     """Compare both models on every scene and write ``<out_dir>/report.md``.
 
@@ -116,7 +122,8 @@ def gallery(scenes: Sequence[Scene | str | Path] | None, out_dir: str | Path, *,
     scenes
         Scenes or scene files; ``None`` means the shipped ``scenes/paper-*.toml``.
     out_dir
-        One sub-folder per scene (see :func:`~comparisons.compare.compare`) and ``report.md``.
+        One sub-folder per scene (see :func:`~comparisons.compare.compare`; the models' results
+        inside it unless ``results_root`` is given) and ``report.md``.
     reuse, progress, results_root, solvers
         Passed to :func:`~comparisons.compare.compare`.
     """

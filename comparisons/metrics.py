@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, is_dataclass
 
+from comparisons.pair import BEAM, REFERENCE
 from comparisons.paths import LOAD, CurveError, curve_error, limit_loads, path_curve, series
 from comparisons.profiles import (
     DEFLECTIONS,
@@ -31,7 +32,7 @@ from comparisons.profiles import (
     peak_error,
     profile_error,
 )
-from comparisons.runs import BEAM, REFERENCE, ModelRun
+from models import ModelRun
 from sandwich.results import Solution
 
 PEAK_WINDOW = 5.0  # mm: averaging window of the windowed stress peaks (10 face thicknesses)

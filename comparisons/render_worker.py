@@ -1,23 +1,19 @@
-"""Child process that renders one field snapshot with pyvista: ``NPZ PNG MODEL SCALE``."""
+"""Child process rendering one field frame with pyvista.
+
+Arguments: ``VTU PNG MODEL STEP LOAD_FACTOR SCALE``.
+"""
 
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from comparisons.deformed import render_with_pyvista
-from comparisons.snapshots import FieldSnapshot
+from comparisons.deformed import picture_from_vtu, render_with_pyvista
 
 
 def main(argv: list[str]) -> int:
-    """Render the snapshot stored in ``argv[0]`` into ``argv[1]``."""
-    npz, png, model, scale = argv
-    with np.load(npz) as z:
-        snap = FieldSnapshot(model=model, step=int(z["step"]), load_factor=float(z["load_factor"]),
-                             points=z["points"], displacement=z["displacement"], cells=z["cells"],
-                             von_mises=z["von_mises"],
-                             region=z["region"] if "region" in z else None)
-    render_with_pyvista(snap, Path(png), scale=float(scale))
+    """Render the frame stored in ``argv[0]`` into ``argv[1]``."""
+    vtu, png, model, step, load_factor, scale = argv
+    pic = picture_from_vtu(Path(vtu), model, int(step), float(load_factor))
+    render_with_pyvista(pic, Path(png), scale=float(scale))
     return 0
 
 

@@ -12,9 +12,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from sandwich.scene import Scene
+from sandwich.scene import MESH_LEVELS, Scene
 
-LEVELS = ("coarse", "medium", "fine", "explicit")
+LEVELS = MESH_LEVELS
 LEVEL_SUBDIVISION = {"coarse": 1, "medium": 2, "fine": 4, "explicit": 1}
 
 COARSE_GROWTH = 1.5  # largest length ratio of neighbouring elements along x at level coarse

@@ -99,11 +99,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         # scene's tolerance or that bound, whichever is larger (reported in the summary)
         roundoff = system.residual_roundoff_bound()
         newton_tol = max(a.tol, roundoff)
-        options = PathOptions(
-            control=a.control, until_load_factor=a.until_load_factor,
-            until_probe=a.until_probe, until_value=a.until_value, max_steps=a.max_steps,
-            initial_increment=a.initial_increment, min_increment=a.min_increment,
-            max_increment=a.max_increment, tol=newton_tol, max_iterations=a.max_iterations)
+        options = PathOptions.from_analysis(a, tol=newton_tol)
         result = follow_path(system, options, names, progress=record)
         converged, message = result.reached_target, result.message
         limit_points = result.limit_points

@@ -1,5 +1,11 @@
-"""Shared layer of the project: scenes, result types and writers, the generic path-following solver.
+"""Shared layer of the project, its ground floor: the contract every model and tool meets.
 
-Every model (``beam_element``, ``meshes`` + ``reference2d``) may import this package; it imports no
-model.
+- scenes: :mod:`sandwich.scene` (types, vocabularies, defaults), :mod:`sandwich.scene_checks`
+  (validation), :mod:`sandwich.scene_file` (``load_scene``);
+- results: :mod:`sandwich.results` (types, writers, readers, a result's identity);
+- the generic path-following solver: :mod:`sandwich.solver`; a progress display.
+
+Every model (``beam_element``, ``meshes`` + ``reference2d``) and tool above them may import this
+package; it imports no model, no registry, no comparison, no command line
+(``tests/test_layers.py``).
 """

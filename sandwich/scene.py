@@ -1,15 +1,14 @@
 """Scene files (TOML): the typed scene every model consumes, and its loader.
 
 A scene describes one problem — geometry, materials, debonds, supports, loads, analysis, probes —
-in N, mm and MPa. :func:`load_scene` parses and validates it; every problem found is reported at
-once as a :class:`SceneError` that names the file, the key and the reason. The checks themselves
-live in :mod:`sandwich.scene_checks`.
+in N, mm and MPa. :func:`sandwich.scene_file.load_scene` reads, checks and returns it; every
+problem found is reported at once as a :class:`SceneError` that names the file, the key and the
+reason. The checks themselves live in :mod:`sandwich.scene_checks`. This module imports neither.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -19,6 +18,11 @@ SUPPORT_SITES = ("top", "bottom", "faces")
 SUPPORT_TYPES = ("pin", "roller", "clamp")
 ANALYSIS_KINDS = ("linear", "nonlinear")
 CONTROLS = ("load", "displacement", "arc-length")
+GRADINGS = ("graded", "tips", "uniform")  # [beam_model] grading: the beam mesh along x
+FACE_MEMBRANES = ("paper", "averaged")  # [beam_model] face_membrane
+MESH_LEVELS = ("coarse", "medium", "fine", "explicit")  # [reference2d] level: the 2D mesh
+# Scene and probe names become folder and file names (results/<scene>/, load_<probe>.png)
+NAME_PATTERN = r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}"
 CORE_BASES = ("sublayers", "polynomial")  # enrichment families of the beam's core levels
 MAX_CORE_LEVEL = 6
 
@@ -267,23 +271,6 @@ class Scene:
             if p.name == name:
                 return p
         raise KeyError(name)
-
-
-def load_scene(path: str | Path) -> Scene:
-    """Read, check and return the scene in ``path``; raise :class:`SceneError` if it is bad."""
-    from sandwich.scene_checks import build_scene
-
-    path = Path(path)
-    fname = str(path)
-    if not path.is_file():
-        raise SceneError([Problem(fname, "-", "no such file")])
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as exc:
-        raise SceneError([Problem(fname, "-", f"not UTF-8 text ({exc.reason})")]) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError([Problem(fname, "-", f"not valid TOML: {exc}")]) from None
-    return build_scene(data, fname, source=path)
 
 
 def is_finite_number(value: object) -> bool:

@@ -7,6 +7,7 @@ bad scene is answered with one line per problem before any model does any work.
 from __future__ import annotations
 
 import difflib
+import re
 from pathlib import Path
 from typing import Any
 
@@ -14,9 +15,13 @@ from sandwich.scene import (
     ANALYSIS_KINDS,
     CONTROLS,
     CORE_BASES,
+    FACE_MEMBRANES,
     FACES,
+    GRADINGS,
     INTERFACES,
     MAX_CORE_LEVEL,
+    MESH_LEVELS,
+    NAME_PATTERN,
     SUPPORT_SITES,
     SUPPORT_TYPES,
     Analysis,
@@ -39,6 +44,10 @@ from sandwich.scene import (
 TOP_KEYS = ("name", "description", "beam", "layers", "materials", "debonds", "supports", "loads",
             "analysis", "probes", "beam_model", "reference2d")
 GEOMETRY_TOL = 1e-9  # mm: two stations closer than this are the same station
+MAX_MAGNITUDE = 1e12  # any number of a scene (N, mm, MPa): beyond it sizes overflow the meshers
+MIN_SIZE = 1e-6  # mm: the smallest length, width or thickness (1 nm)
+MIN_STIFFNESS_DET = 1e-6  # 1 - (Ex/Ez) nu_zx^2 below this: a nearly singular material
+MIN_TOL = 1e-14  # the Newton tolerance cannot go below round-off
 _MISSING = object()
 
 
@@ -82,6 +91,10 @@ class Reader:
                       else f"expected a number, got {_typename(v)}")
             return None
         v = float(v)
+        if abs(v) > MAX_MAGNITUDE:
+            self.fail(full, f"{v:g} is beyond any physical scale of this tool (|value| <= "
+                      f"{MAX_MAGNITUDE:g} in N, mm, MPa)")
+            return None
         if positive and v <= 0:
             self.fail(full, f"must be positive, got {v:g}")
             return None
@@ -158,6 +171,7 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
     r.table(data, "", TOP_KEYS, required=("name", "beam", "layers", "materials", "supports",
                                           "loads", "analysis"))
     name = r.string(data, "name", "", default="")
+    _check_name(r, name, "name")
     description = data.get("description", "")
     if not isinstance(description, str):
         r.fail("description", f"expected a string, got {_typename(description)}")
@@ -188,12 +202,29 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
                  reference2d=reference2d, source=source)
 
 
+def _check_name(r: Reader, name: Any, key: str) -> bool:
+    """Refuse a name that cannot be a folder or file name (it becomes one in the results)."""
+    if isinstance(name, str) and name and not re.fullmatch(NAME_PATTERN, name):
+        r.fail(key, f"'{name[:40]}' cannot name a result folder or file: use 1-100 letters, "
+               "digits, '.', '_' or '-', starting with a letter or digit")
+        return False
+    return True
+
+
 def _beam(r: Reader, tbl: Any) -> tuple[float, float]:
     t = r.table(tbl, "beam", ("length", "width"), required=("length", "width"))
     if t is None:
         return 0.0, 0.0
-    return (r.number(t, "length", "beam", positive=True) or 0.0,
-            r.number(t, "width", "beam", positive=True) or 0.0)
+    return (_size(r, t, "length", "beam") or 0.0, _size(r, t, "width", "beam") or 0.0)
+
+
+def _size(r: Reader, t: dict[str, Any], k: str, key: str) -> float | None:
+    """A positive length (mm) no smaller than ``MIN_SIZE``."""
+    v = r.number(t, k, key, positive=True)
+    if v is not None and v < MIN_SIZE:
+        r.fail(_join(key, k), f"{v:g} mm is below the smallest size {MIN_SIZE:g} mm")
+        return None
+    return v
 
 
 def _materials(r: Reader, tbl: Any) -> dict[str, Material]:
@@ -216,6 +247,10 @@ def _materials(r: Reader, tbl: Any) -> dict[str, Material]:
                 r.fail(f"{key}.nu", f"{nu:g} makes the plane-stress stiffness not positive "
                        "definite (need -1 < nu < 1)")
                 nu = None
+            elif nu is not None and 1.0 - nu**2 < MIN_STIFFNESS_DET:
+                r.fail(f"{key}.nu", f"{nu:g} makes the plane-stress stiffness nearly singular "
+                       f"(1 - nu^2 = {1 - nu**2:.3g} < {MIN_STIFFNESS_DET:g})")
+                nu = None
             if E is not None and nu is not None:
                 out[mname] = Material(mname, "isotropic", E, E, E / (2 * (1 + nu)), nu)
         else:
@@ -230,6 +265,10 @@ def _materials(r: Reader, tbl: Any) -> dict[str, Material]:
             if 1.0 - (Ex / Ez) * nu**2 <= 0.0:
                 r.fail(f"{key}.nu_zx", f"1 - (Ex/Ez) nu_zx^2 = {1 - Ex / Ez * nu**2:.3g} <= 0: "
                        "the plane-stress stiffness is not positive definite")
+                continue
+            if 1.0 - (Ex / Ez) * nu**2 < MIN_STIFFNESS_DET:
+                r.fail(f"{key}.nu_zx", f"1 - (Ex/Ez) nu_zx^2 = {1 - Ex / Ez * nu**2:.3g} < "
+                       f"{MIN_STIFFNESS_DET:g}: the plane-stress stiffness is nearly singular")
                 continue
             out[mname] = Material(mname, "orthotropic", Ex, Ez, G, nu)
     return out
@@ -248,7 +287,7 @@ def _layers(r: Reader, tbl: Any, materials: dict[str, Material]) -> dict[str, La
         lt = r.table(t[lname], key, ("thickness", "material"), required=("thickness", "material"))
         if lt is None:
             continue
-        h = r.number(lt, "thickness", key, positive=True)
+        h = _size(r, lt, "thickness", key)
         mname = r.string(lt, "material", key)
         mat = None
         if isinstance(mname, str):
@@ -367,6 +406,8 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
         if t is None:
             continue
         name = r.string(t, "name", key)
+        if not _check_name(r, name, f"{key}.name"):
+            name = None
         on = r.choice(t, "on", key, FACES)
         x = _station(r, t, "x", key, L)
         if name is not None and any(p.name == name for p in out):
@@ -384,8 +425,8 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
                 required=("kind", "until"))
     if t is None:
         return Analysis()
-    kind = r.choice(t, "kind", key, ANALYSIS_KINDS, default="nonlinear")
-    control = r.choice(t, "control", key, CONTROLS, default="load")
+    kind = r.choice(t, "kind", key, ANALYSIS_KINDS, default=Analysis.kind)
+    control = r.choice(t, "control", key, CONTROLS, default=Analysis.control)
     until_probe = until_value = until_lf = None
     if "until" in t:
         u = r.table(t["until"], "analysis.until", ("probe", "value", "load_factor"))
@@ -412,20 +453,24 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     if control == "displacement" and kind == "nonlinear" and "until" in t and until_probe is None:
         r.fail("analysis.control", "displacement control needs until = { probe, value }: "
                "the probe is the controlled displacement")
-    max_steps = r.integer(t, "max_steps", key, default=200, lo=1, hi=100_000)
+    d = Analysis()
+    max_steps = r.integer(t, "max_steps", key, default=d.max_steps, lo=1, hi=100_000)
     inc = r.number(t, "initial_increment", key, default=None, positive=True)
     lo = r.number(t, "min_increment", key, default=None, positive=True)
     hi = r.number(t, "max_increment", key, default=None, positive=True)
     if lo is not None and hi is not None and lo > hi:
         r.fail("analysis.min_increment", f"{lo:g} is larger than max_increment {hi:g}")
-    tol = r.number(t, "tol", key, default=1e-8, positive=True)
+    tol = r.number(t, "tol", key, default=d.tol, positive=True)
     if tol is not None and tol >= 1e-2:
         r.fail("analysis.tol", f"{tol:g} is too loose for equilibrium (use < 1e-2)")
-    max_it = r.integer(t, "max_iterations", key, default=25, lo=1, hi=1000)
-    return Analysis(kind=kind or "nonlinear", control=control or "load", until_probe=until_probe,
+    elif tol is not None and tol < MIN_TOL:
+        r.fail("analysis.tol", f"{tol:g} is below round-off: Newton cannot reach it "
+               f"(use >= {MIN_TOL:g})")
+    max_it = r.integer(t, "max_iterations", key, default=d.max_iterations, lo=1, hi=1000)
+    return Analysis(kind=kind or d.kind, control=control or d.control, until_probe=until_probe,
                     until_value=until_value, until_load_factor=until_lf,
-                    max_steps=max_steps or 200, initial_increment=inc, min_increment=lo,
-                    max_increment=hi, tol=tol or 1e-8, max_iterations=max_it or 25)
+                    max_steps=max_steps or d.max_steps, initial_increment=inc, min_increment=lo,
+                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations)
 
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
@@ -470,9 +515,9 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
                                  hi=MAX_CORE_LEVEL) or d.max_core_level,
         core_zones=tuple(zones),
         elements=r.integer(t, "elements", key, default=d.elements, lo=2, hi=200_000) or d.elements,
-        grading=r.choice(t, "grading", key, ("graded", "tips", "uniform"), default=d.grading)
+        grading=r.choice(t, "grading", key, GRADINGS, default=d.grading)
         or d.grading,
-        face_membrane=r.choice(t, "face_membrane", key, ("paper", "averaged"),
+        face_membrane=r.choice(t, "face_membrane", key, FACE_MEMBRANES,
                                default=d.face_membrane) or d.face_membrane,
         gauss_x=r.integer(t, "gauss_x", key, default=None, lo=2, hi=12),
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
@@ -489,7 +534,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
     if t is None:
         return Reference2DOptions()
     d = Reference2DOptions()
-    level = r.choice(t, "level", key, ("coarse", "medium", "fine", "explicit"), default=d.level)
+    level = r.choice(t, "level", key, MESH_LEVELS, default=d.level)
     sizes = {k: r.number(t, k, key, default=None, positive=True)
              for k in ("core_size", "face_size", "tip_size")}
     if level == "explicit" and sizes["core_size"] is None:
@@ -500,7 +545,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
         half = False
     return Reference2DOptions(
         level=level or d.level,
-        refine=r.integer(t, "refine", key, default=0, lo=0, hi=6) or 0,
+        refine=r.integer(t, "refine", key, default=d.refine, lo=0, hi=6) or 0,
         face_elements=r.integer(t, "face_elements", key, default=d.face_elements, lo=1, hi=16)
         or d.face_elements,
         half_model=half,

@@ -2,11 +2,12 @@
 
 import csv
 import json
+import os
 from pathlib import Path
 
 import pytest
 
-from sandwich.cli import main
+from sandwich_cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -63,3 +64,120 @@ def test_bad_model_name_is_a_usage_error_not_a_traceback(capsys):
         main(["solve", str(ROOT / "scenes" / "default.toml"), "--model", "fem3d"])
     assert info.value.code == 2
     assert "invalid choice" in capsys.readouterr().err
+
+
+def test_progress_is_a_few_lines_when_not_a_terminal(tmp_path):
+    import io
+    from types import SimpleNamespace
+
+    from sandwich.progress import PathProgress
+    from sandwich.scene_file import load_scene
+
+    scene = load_scene(_small_scene(tmp_path))  # until w_top_mid = -1
+    log = io.StringIO()  # not a terminal
+    with PathProgress(scene, "small", stream=log) as bar:
+        for i in range(1, 101):
+            bar(SimpleNamespace(step=i, load_factor=float(i), probes={"w_top_mid": -i / 100}))
+    lines = log.getvalue().splitlines()
+    assert 10 <= len(lines) <= 11  # one per tenth of the way, not one per step
+    assert lines[-1].startswith("small: 100% step 100")
+    assert "\r" not in log.getvalue()
+
+
+def test_library_log_lines_are_held_back_unless_verbose():
+    import logging
+
+    from sandwich_cli.commands import _hush_libraries, _unhush_libraries
+
+    seen = []
+    handler = logging.Handler()
+    handler.emit = lambda record: seen.append(record.getMessage())
+    root = logging.getLogger()
+    root.addHandler(handler)
+    try:
+        _hush_libraries()
+        root.setLevel(logging.INFO)  # as setuptools does when the 2D forms are compiled
+        root.info("running build_ext")
+        logging.getLogger("UFL").warning("Discontinuous Lagrange element requested")
+        root.error("a real error")
+        _unhush_libraries()
+        root.info("shown again")
+    finally:
+        root.removeHandler(handler)
+        root.setLevel(logging.WARNING)
+    assert seen == ["a real error", "shown again"]
+
+
+def test_warnings_before_a_solve(tmp_path):
+    import dataclasses
+
+    from sandwich.scene import Analysis, Load
+    from sandwich.scene_file import load_scene
+    from sandwich_cli.commands import warnings_before_solve
+
+    scene = load_scene(ROOT / "scenes" / "default.toml")
+    assert warnings_before_solve(scene, "beam") == []
+    pin = scene.supports[0]
+    over = dataclasses.replace(scene, loads=(Load(pin.faces[0], pin.x, 0.0, -1.0),),
+                               analysis=Analysis(kind="linear", until_load_factor=-2.0))
+    said = " / ".join(warnings_before_solve(over, "beam"))
+    assert "acts over supports[0]" in said and "reverses every load" in said
+
+
+def test_an_internal_error_names_its_crash_log_and_leaves_the_current_folder_clean(
+        tmp_path, monkeypatch, capsys):
+    import re
+
+    from sandwich_cli import commands
+
+    def broken(args):
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(commands, "cmd_validate", broken)
+    work = tmp_path / "cwd"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    work.chmod(0o555)  # even a read-only current folder gets no crash log and no crash
+    try:
+        code = main(["validate", str(ROOT / "scenes" / "default.toml")])
+    finally:
+        work.chmod(0o755)
+    err = capsys.readouterr().err
+    assert code == 3 and "internal error (RuntimeError: a bug)" in err
+    log = re.search(r"details in (\S+)", err).group(1)
+    assert "Traceback" in Path(log).read_text() and list(work.iterdir()) == []
+    Path(log).unlink()
+
+
+def test_ctrl_c_in_a_real_solve_keeps_the_converged_steps(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "r"
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "sandwich_cli", "solve", str(ROOT / "scenes" / "default.toml"),
+         "--model", "beam", "--out", str(out)],
+        cwd=tmp_path, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env)
+    lines = []
+    t0 = time.monotonic()
+    for line in proc.stderr:  # not a terminal: one progress line per tenth of the way
+        lines.append(line)
+        if "% step" in line and int(line.split("% step ")[1].split(",")[0]) >= 5:
+            break
+        assert time.monotonic() - t0 < 300, lines
+    proc.send_signal(signal.SIGINT)
+    rest = proc.stderr.read()
+    code = proc.wait(timeout=120)
+    if "reached" in rest and code == 0:  # the path finished before the signal landed
+        pytest.skip("the solve ended before the interrupt")
+    assert code == 1, rest
+    assert "interrupted" in rest and "Traceback" not in rest
+    with open(out / "history.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) >= 2 and float(rows[-1]["w_top_mid"]) < 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is False and "interrupted after step" in summary["message"]
+    assert list(tmp_path.iterdir()) == [out]

@@ -7,7 +7,7 @@ import numpy as np
 
 from beam_element.dofs import global_dof
 from beam_element.solve import run
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -32,7 +32,7 @@ so in the linear range the λ and u parts of the arc weigh the same.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -122,6 +122,17 @@ class PathOptions:
     target_tol: float = 1e-6
     target_accept: float = 1e-3
 
+    @classmethod
+    def from_analysis(cls, analysis: object, **overrides: object) -> PathOptions:
+        """The options of a scene's ``[analysis]`` (:class:`sandwich.scene.Analysis`).
+
+        ``overrides`` are a model's own settings on top (e.g. a Newton tolerance floor, an
+        increment floor, ``desired_iterations``); ``None`` values among them are kept.
+        """
+        names = ("control", "until_load_factor", "until_probe", "until_value", "max_steps",
+                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations")
+        return cls(**{**{n: getattr(analysis, n) for n in names}, **overrides})
+
     def __post_init__(self) -> None:
         if self.control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}, got {self.control!r}")
@@ -187,6 +198,46 @@ def _fmt_probes(probes: dict[str, float]) -> str:
     return ", ".join(f"{k} = {v:.6g}" for k, v in probes.items())
 
 
+@dataclass
+class _StepSize:
+    """The step-size controller: the increment ``h`` in the units of the control and its bounds.
+
+    Halved on a failed try (by :meth:`_Follower._converge_step`); after a converged step scaled
+    by ``√(desired_iterations / iterations)`` within [½, 2], never grown after a cut, and kept
+    in [``h_min``, ``h_max``].
+    """
+
+    h: float
+    h_min: float
+    h_max: float
+    desired_iterations: int
+
+    @classmethod
+    def start(cls, opt: PathOptions, h_auto: Callable[[], float]) -> _StepSize:
+        """The first increment (the options', else ``h_auto()`` within the bounds given)."""
+        h = opt.initial_increment
+        if h is None:  # automatic, kept within the bounds the user gave
+            h = h_auto()
+            if opt.max_increment is not None:
+                h = min(h, opt.max_increment)
+            if opt.min_increment is not None:
+                h = max(h, opt.min_increment)
+        h_min = opt.min_increment if opt.min_increment is not None else 1e-4 * h
+        h_max = opt.max_increment if opt.max_increment is not None else 10.0 * h
+        if not (0.0 < h_min <= h <= h_max):
+            raise ValueError(f"need 0 < min_increment <= increment <= max_increment, got "
+                             f"{h_min}, {h}, {h_max}")
+        return cls(h, h_min, h_max, opt.desired_iterations)
+
+    def after(self, h_try: float, iterations: int, cuts: int) -> None:
+        """The increment of the next step after one of ``h_try`` converged."""
+        factor = math.sqrt(self.desired_iterations / max(iterations, 1))
+        factor = min(max(factor, 0.5), 2.0)
+        if cuts:
+            factor = min(factor, 1.0)
+        self.h = min(max(h_try * factor, self.h_min), self.h_max)
+
+
 class _Follower:
     """State machine of :func:`follow_path` (one instance per call)."""
 
@@ -217,12 +268,13 @@ class _Follower:
     def wnorm(self, du: np.ndarray, dlam: float) -> float:
         return math.sqrt(self.dot(du, du) + (self.psi * dlam) ** 2)
 
-    def accept(self, u: np.ndarray, lam: float, its: int, neg: int | None, cuts: int) -> None:
+    def accept(self, u: np.ndarray, lam: float, its: int, neg: int | None,
+               cuts: int) -> PathState:
+        """Record and commit a converged state; return it (the caller yields it)."""
         state = PathState(len(self.states), u.copy(), float(lam), its, self.probes(u), neg, cuts)
         self.states.append(state)
         self.system.commit(state.u.copy(), state.load_factor)
-        if self.progress is not None:
-            self.progress(state)
+        return state
 
     def finish(self, reached: bool, message: str) -> PathResult:
         if self.rescues:
@@ -233,32 +285,40 @@ class _Follower:
 
     # -- the run -------------------------------------------------------------------------------
     def run(self) -> PathResult:
+        """Follow the path, calling ``progress`` with every converged state."""
+        states = self.converged_states()
+        while True:
+            try:
+                state = next(states)
+            except StopIteration as done:
+                return done.value
+            if self.progress is not None:
+                self.progress(state)
+
+    def converged_states(self) -> Generator[PathState, None, PathResult]:
+        """Yield every converged state (state 0 first); return the :class:`PathResult`.
+
+        One step is :meth:`_converge_step` (predictor-corrector tries with cuts and the probe
+        rescue), then the target strategies (:meth:`_hit_crossed_target`,
+        :meth:`_target_reached`, :meth:`_near_target`), then the step-size controller
+        (:class:`_StepSize`). The follower's state (last states, previous step, arc sign,
+        rescue memory) lives in this object.
+        """
         opt = self.opt
         u0 = np.zeros(self.system.size)
         try:
             fac = self.system.factorize(self.system.tangent(u0))
             t = np.asarray(fac.solve(self.f_ref), dtype=float)
         except RECOVERABLE_ERRORS as exc:
-            self.accept(u0, 0.0, 0, None, 0)
+            yield self.accept(u0, 0.0, 0, None, 0)
             return self.finish(False, f"step 1: the initial tangent cannot be factorised ({exc})")
-        self.accept(u0, 0.0, 0, fac.negative_pivots, 0)
+        yield self.accept(u0, 0.0, 0, fac.negative_pivots, 0)
         tn = math.sqrt(self.dot(t, t))
         if not math.isfinite(tn) or tn == 0.0:
             return self.finish(False, "step 1: f_ref is zero or the linear solution is not finite")
         self.psi = opt.arc_load_weight * tn
         self.lam_est = self._target_load_estimate(t)
-        h = opt.initial_increment
-        if h is None:  # automatic, kept within the bounds the user gave
-            h = self._auto_increment(t)
-            if opt.max_increment is not None:
-                h = min(h, opt.max_increment)
-            if opt.min_increment is not None:
-                h = max(h, opt.min_increment)
-        h_min = opt.min_increment if opt.min_increment is not None else 1e-4 * h
-        h_max = opt.max_increment if opt.max_increment is not None else 10.0 * h
-        if not (0.0 < h_min <= h <= h_max):
-            raise ValueError(f"need 0 < min_increment <= increment <= max_increment, got "
-                             f"{h_min}, {h}, {h_max}")
+        size = _StepSize.start(opt, lambda: self._auto_increment(t))
         self.prev_step: tuple[np.ndarray, float] | None = None
         self.recent: list[tuple[float, float]] = []  # (increment, until-probe change) accepted
         self.peak = 0.0  # largest accepted increment so far
@@ -274,41 +334,10 @@ class _Follower:
             step = last.step + 1
             if opt.control == "arc-length":
                 self.sigma = self._arc_direction(t, last)
-            cuts = 0
-            rescued = False
-            while True:
-                h_try, direct = self._clip_to_target(h, last)
-                trial, reason = self._attempt(h_try, last, t)
-                if trial is not None:
-                    break
-                h = 0.5 * h_try
-                cuts += 1
-                if not rescued and self._rescue_due(cuts, h):
-                    rescued = True
-                    trial, direct = self._probe_rescue(last, t)
-                    if trial is not None:
-                        self.rescues.append(step)
-                        h_try = self.wnorm(trial.u - last.u, trial.load_factor - last.load_factor)
-                        break
-                if h < h_min:
-                    hint = ""
-                    if reason.startswith(INADMISSIBLE):
-                        hint = (" The path leaves the model's admissible domain here (its "
-                                "equations have no physical meaning beyond); the states before "
-                                "it are kept.")
-                    elif opt.control == "load":
-                        hint = (" Under load control this usually means a load maximum (limit "
-                                "point) is near; use displacement or arc-length control.")
-                    elif opt.control == "displacement":
-                        hint = (" Under displacement control this usually means the driven "
-                                "probe has a turning point (snap-back) near; use arc-length "
-                                "control.")
-                    return self.finish(False, (
-                        f"step {step}: no convergence from λ = {last.load_factor:.6g} "
-                        f"({_fmt_probes(last.probes)}): the {opt.control} increment was cut "
-                        f"{cuts} time(s), last to {h_try:.3g}, and may not go below "
-                        f"min_increment = {h_min:.3g}; "
-                        f"last reason: {reason}.{hint}"))
+            outcome = self._converge_step(size, last, t, step)
+            if isinstance(outcome, str):
+                return self.finish(False, outcome)
+            trial, h_try, direct, cuts = outcome
             crossed = ""
             if not direct:
                 trial, h_try, crossed = self._hit_crossed_target(trial, h_try, last, t)
@@ -318,7 +347,8 @@ class _Follower:
                 self.recent = [*self.recent, (h_try, dv)][-RESCUE_MEMORY:]
                 self.peak = max(self.peak, h_try)
             fac = trial.factorization
-            self.accept(trial.u, trial.load_factor, trial.iterations, fac.negative_pivots, cuts)
+            yield self.accept(trial.u, trial.load_factor, trial.iterations, fac.negative_pivots,
+                              cuts)
             try:
                 t = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
@@ -327,23 +357,69 @@ class _Follower:
             if done:
                 return self.finish(True, done)
             if crossed:
-                s = self.states[-1]
-                near = self._near_target(crossed, s)
-                if near:
-                    return self.finish(True, near)
-                return self.finish(False, (
-                    f"step {s.step}: the target on {crossed} was crossed but could not be hit "
-                    f"within target_tol = {opt.target_tol:g} (stopped at λ = "
-                    f"{s.load_factor:.6g}, {_fmt_probes(s.probes)})"))
-            factor = math.sqrt(opt.desired_iterations / max(trial.iterations, 1))
-            factor = min(max(factor, 0.5), 2.0)
-            if cuts:
-                factor = min(factor, 1.0)
-            h = min(max(h_try * factor, h_min), h_max)
+                return self._finish_crossed(crossed)
+            size.after(h_try, trial.iterations, cuts)
         s = self.states[-1]
         return self.finish(False, (
             f"max_steps = {opt.max_steps} reached at λ = {s.load_factor:.6g} "
             f"({_fmt_probes(s.probes)}) before the target"))
+
+    def _converge_step(self, size: _StepSize, last: PathState, t: np.ndarray,
+                       step: int) -> tuple[_Trial, float, bool, int] | str:
+        """Try steps from ``last``, halving the increment on failure, with one probe rescue.
+
+        Returns the converged trial, its increment, whether it hit a controlled target
+        directly, and the number of cuts; or, when the increment would go below its floor, the
+        message saying where and why the path stops.
+        """
+        opt = self.opt
+        cuts = 0
+        rescued = False
+        while True:
+            h_try, direct, sign = self._clip_to_target(size.h, last)
+            if sign is not None:  # towards a directly controlled target
+                self.sigma = sign
+            trial, reason = self._attempt(h_try, last, t)
+            if trial is not None:
+                return trial, h_try, direct, cuts
+            size.h = 0.5 * h_try
+            cuts += 1
+            if not rescued and self._rescue_due(cuts, size.h):
+                rescued = True
+                trial, direct = self._probe_rescue(last, t)
+                if trial is not None:
+                    self.rescues.append(step)
+                    h_try = self.wnorm(trial.u - last.u, trial.load_factor - last.load_factor)
+                    return trial, h_try, direct, cuts
+            if size.h < size.h_min:
+                hint = ""
+                if reason.startswith(INADMISSIBLE):
+                    hint = (" The path leaves the model's admissible domain here (its "
+                            "equations have no physical meaning beyond); the states before "
+                            "it are kept.")
+                elif opt.control == "load":
+                    hint = (" Under load control this usually means a load maximum (limit "
+                            "point) is near; use displacement or arc-length control.")
+                elif opt.control == "displacement":
+                    hint = (" Under displacement control this usually means the driven "
+                            "probe has a turning point (snap-back) near; use arc-length "
+                            "control.")
+                return (f"step {step}: no convergence from λ = {last.load_factor:.6g} "
+                        f"({_fmt_probes(last.probes)}): the {opt.control} increment was cut "
+                        f"{cuts} time(s), last to {h_try:.3g}, and may not go below "
+                        f"min_increment = {size.h_min:.3g}; "
+                        f"last reason: {reason}.{hint}")
+
+    def _finish_crossed(self, crossed: str) -> PathResult:
+        """End of a path whose step crossed the target on ``crossed`` without hitting it."""
+        s = self.states[-1]
+        near = self._near_target(crossed, s)
+        if near:
+            return self.finish(True, near)
+        return self.finish(False, (
+            f"step {s.step}: the target on {crossed} was crossed but could not be hit "
+            f"within target_tol = {self.opt.target_tol:g} (stopped at λ = "
+            f"{s.load_factor:.6g}, {_fmt_probes(s.probes)})"))
 
     # -- pieces ------------------------------------------------------------------------------
     def _target_load_estimate(self, t: np.ndarray) -> float:
@@ -369,25 +445,25 @@ class _Follower:
             return abs(self.dot(self.c[name], t)) * lam / 20.0 or lam / 20.0
         return lam * math.sqrt(self.dot(t, t) + self.psi**2) / 20.0
 
-    def _clip_to_target(self, h: float, last: PathState) -> tuple[float, bool]:
+    def _clip_to_target(self, h: float, last: PathState) -> tuple[float, bool, float | None]:
         """Shorten ``h`` so that a directly controlled target is hit exactly.
 
-        Returns the increment and whether the target of the control variable is hit by it.
+        Returns the increment, whether the target of the control variable is hit by it, and the
+        sign of the control's direction towards that target (``None`` when the control has no
+        target of its own: the sign is then the follower's).
         """
         opt = self.opt
         if opt.control == "load" and opt.until_load_factor is not None:
             rem = abs(opt.until_load_factor - last.load_factor)
-            self.sigma = math.copysign(1.0, opt.until_load_factor - last.load_factor)
-            if h >= rem:
-                return rem, True
+            sign = math.copysign(1.0, opt.until_load_factor - last.load_factor)
+            return (rem, True, sign) if h >= rem else (h, False, sign)
         if (opt.control == "displacement" and opt.until_probe is not None
                 and opt.driven_probe == opt.until_probe):
             v = last.probes[opt.until_probe]
             rem = abs(opt.until_value - v)
-            self.sigma = math.copysign(1.0, opt.until_value - v)
-            if h >= rem:
-                return rem, True
-        return h, False
+            sign = math.copysign(1.0, opt.until_value - v)
+            return (rem, True, sign) if h >= rem else (h, False, sign)
+        return h, False, None
 
     def _arc_direction(self, t: np.ndarray, last: PathState) -> float:
         """Sign of the arc-length predictor: forward along the path.

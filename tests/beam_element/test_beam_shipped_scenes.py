@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from beam_element import run
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 SCENES = sorted((Path(__file__).resolve().parents[2] / "scenes").glob("*.toml"))
 TEST_ELEMENTS = 40

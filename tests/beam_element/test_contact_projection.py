@@ -32,7 +32,7 @@ from beam_element.contact import (
 from beam_element.dofs import CONTACT_DOFS, NODE_DOFS, global_dof
 from beam_element.model import build_model
 from beam_element.shape_functions import x_shape
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 EPS = 2.24e4  # N/mm³, the default penalty for the paper's Rohacell core
 S = 1e-6  # mm, the default regularisation width for 0.5 mm faces

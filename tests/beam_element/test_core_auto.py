@@ -17,7 +17,8 @@ from beam_scenes import sandwich_scene
 from beam_element import run
 from beam_element.model import build_model
 from beam_element.solve import linear_solution
-from sandwich.scene import Analysis, CoreZone, load_scene
+from sandwich.scene import Analysis, CoreZone
+from sandwich.scene_file import load_scene
 
 SCENES = sorted((Path(__file__).resolve().parents[2] / "scenes").glob("*.toml"))
 

@@ -7,7 +7,7 @@ import pytest
 
 from beam_element.mesh import build_mesh
 from beam_element.model import build_model
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 SCENES = Path(__file__).parents[2] / "scenes"
 FIG5 = dict(stations=[130, 170, 0, 300, 145, 155, 150, 150],

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from beam_element import run
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 SCENE = Path(__file__).parents[2] / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
 

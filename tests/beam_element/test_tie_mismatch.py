@@ -1,6 +1,6 @@
 """Interface-tie mismatch of the paper's element: where it vanishes, its order, its soft-core scale.
 
-Reference: ``docs/tie_mismatch.md`` and ``benchmarks/beam_tie_mismatch.py``. At bonded nodes the
+Reference: ``docs/tie_mismatch.md`` and ``studies/tie_mismatch.py``. At bonded nodes the
 element ties u_c = u_face, w_c = w_face, w_c,x = w_face,x; inside an element the face's u is linear
 and the core's boundary u cubic with its own slope DOF, so the slip δu = u_core − u_face is zero at
 the nodes only, while δw is zero everywhere (same Hermite functions, same nodal data). Between
@@ -13,27 +13,20 @@ l ≲ l* = c √(E_x/G_zx); above ~10 l* the deflection error is that of a core 
 """
 
 import dataclasses
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from beam_element import run
-from sandwich.scene import Analysis, load_scene
+from sandwich.scene import Analysis
+from sandwich.scene_file import load_scene
+from studies import tie_mismatch
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _bench():
-    spec = importlib.util.spec_from_file_location(
-        "beam_tie_mismatch", ROOT / "benchmarks" / "beam_tie_mismatch.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-BENCH = _bench()
+BENCH = tie_mismatch
 
 
 def _fig4_linear():

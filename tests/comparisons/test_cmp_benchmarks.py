@@ -1,29 +1,16 @@
-"""Plumbing of benchmarks/tradeoff.py and benchmarks/extremes.py with synthetic solvers."""
+"""Plumbing of studies.tradeoff and studies.extremes (the benchmarks' code), synthetic solvers."""
 
 import dataclasses
-import importlib.util
 import math
-import sys
 import time
-from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def _load(name):
-    spec = importlib.util.spec_from_file_location(f"bench_{name}",
-                                                  ROOT / "benchmarks" / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod  # dataclasses look their module up while the class is made
-    spec.loader.exec_module(mod)
-    return mod
+from studies import extremes, tradeoff
 
 
 def test_tradeoff_errors_front_and_headline(tmp_path, scene, synth):
-    tradeoff = _load("tradeoff")
     # synthetic convergence: the end load misses the exact one by 8/n (beam) and 4/level² (2D)
     exact = synth.make_solution("2d").final_load_factor
     level_err = {"coarse": 0.04, "medium": 0.01, "fine": 0.0025}
@@ -50,7 +37,6 @@ def test_tradeoff_errors_front_and_headline(tmp_path, scene, synth):
 
 
 def test_tradeoff_says_when_beam_never_reaches_one_percent(scene, synth):
-    tradeoff = _load("tradeoff")
     runs = tradeoff.measure(
         scene, lambda sc: synth.make_solution("beam", eps=0.05),
         lambda sc, level, refine: synth.make_solution("2d"), [10], ["coarse"], [0])
@@ -58,7 +44,6 @@ def test_tradeoff_says_when_beam_never_reaches_one_percent(scene, synth):
 
 
 def test_extremes_cases_rows_and_map(tmp_path, scene, synth):
-    extremes = _load("extremes")
     made = {(sw, v): sc for sw, v, sc in extremes.cases(scene, list(extremes.SWEEPS))}
     assert len(made) == sum(len(v) for v in extremes.SWEEPS.values())
     slender = made[("slenderness", 100)]
@@ -98,7 +83,6 @@ def test_extremes_cases_rows_and_map(tmp_path, scene, synth):
 
 
 def test_extremes_agreement_over_the_common_range_when_a_model_stops_early(scene, synth):
-    extremes = _load("extremes")
     full = synth.make_solution("2d")
     beam = synth.make_solution("beam", eps=0.05)
     half = dataclasses.replace(beam, history=beam.history[:75], converged=False)  # to −7.5 mm
@@ -111,7 +95,6 @@ def test_extremes_agreement_over_the_common_range_when_a_model_stops_early(scene
 
 
 def test_extremes_wall_time_cap_keeps_the_streamed_states(scene, synth):
-    extremes = _load("extremes")
 
     def slow(sc, progress=None):
         for i in range(1, 4):  # three converged states, then a hang

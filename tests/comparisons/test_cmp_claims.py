@@ -50,16 +50,7 @@ def per_scene(scene):
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    import sys
-
-    sys.path.insert(0, str(Path(__file__).parent))
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location(
-        "cmp_conftest", Path(__file__).with_name("conftest.py"))
-    helpers = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(helpers)
-    fake_solvers, scene_copy = helpers.fake_solvers, helpers.scene_copy
+    from cmp_synthetic import fake_solvers, scene_copy
 
     tmp = tmp_path_factory.mktemp("gallery")
     scenes = [scene_copy(p.stem, tmp) for p in shipped_scenes(ROOT)]
@@ -146,9 +137,15 @@ def test_report_lists_scenes_figures_and_claims(run):
 
 
 def test_missing_beam_makes_its_claims_not_checked(tmp_path, synth, monkeypatch):
-    from comparisons import runs as runs_module
+    import dataclasses
 
-    monkeypatch.setitem(runs_module.MODEL_SOURCES, "beam", ("no_such_beam_xyz", ("x",)))
+    from models import registry
+
+    def unimportable(scene, progress=None):
+        raise ModuleNotFoundError("No module named 'no_such_beam_xyz'")
+
+    monkeypatch.setitem(registry.MODELS, "beam",
+                        dataclasses.replace(registry.MODELS["beam"], solve=unimportable))
     solvers = synth.fake_solvers(0.01)
     del solvers["beam"]
     sc = synth.scene_copy("paper-fig4-bonded-3pb", tmp_path)

@@ -6,8 +6,9 @@ import os
 import numpy as np
 import pytest
 
-from comparisons import FieldSnapshot, compare, load_result, save_snapshot
-from comparisons import runs as runs_module
+from comparisons import compare
+from comparisons.deformed import picture_of
+from sandwich.results import FieldFrame, load_result
 
 EPS = 0.03
 
@@ -77,30 +78,51 @@ def test_progress_reports_model_and_step(tmp_path, scene, synth):
     assert phases == [("beam", "start"), ("beam", "done"), ("2d", "start"), ("2d", "done")]
 
 
-def test_fresh_results_are_reused_and_stale_ones_rerun(tmp_path, scene_file, scene, synth):
+def test_results_are_reused_only_for_the_same_identity(tmp_path, scene_file, scene, synth):
     calls = []
     solvers = synth.fake_solvers(EPS, calls=calls)
     compare(scene, tmp_path / "a", results_root=tmp_path / "res", solvers=solvers)
     assert calls == ["beam", "2d"]
-    old = os.path.getmtime(scene_file) - 100  # the results are now clearly newer than the scene
-    os.utime(scene_file, (old, old))
+    future = os.path.getmtime(tmp_path / "res" / scene.name / "beam" / "summary.json") + 100
+    os.utime(scene_file, (future, future))  # a newer file date alone changes nothing
     cmp = compare(scene_file, tmp_path / "b", results_root=tmp_path / "res", solvers=solvers)
     assert calls == ["beam", "2d"]
     assert {r.origin for r in cmp.runs.values()} == {"reused"}
     assert cmp.metrics.curve("load_factor").l2_relative == pytest.approx(EPS, abs=5e-4)
-    future = os.path.getmtime(tmp_path / "res" / scene.name / "beam" / "summary.json") + 100
-    os.utime(scene_file, (future, future))  # the scene was edited after the results
+    # the 2D mesh asked by the scene changes: only the 2D result is stale, and it says why
+    text = scene_file.read_text()
+    scene_file.write_text(text + '\n[reference2d]\nlevel = "fine"\n')
     cmp = compare(scene_file, tmp_path / "c", results_root=tmp_path / "res", solvers=solvers)
-    assert calls == ["beam", "2d", "beam", "2d"]
-    assert {r.origin for r in cmp.runs.values()} == {"run"}
-    compare(scene_file, tmp_path / "d", results_root=tmp_path / "res", solvers=solvers,
+    assert calls == ["beam", "2d", "2d"]
+    assert (cmp.runs["beam"].origin, cmp.runs["2d"].origin) == ("reused", "run")
+    assert "solved at level=medium, the scene asks level=fine" in cmp.runs["2d"].stale
+    # another scene of the same name (a mechanical change): both are solved again
+    scene_file.write_text(text.replace("thickness = 0.5", "thickness = 0.6", 1))
+    cmp = compare(scene_file, tmp_path / "d", results_root=tmp_path / "res", solvers=solvers)
+    assert calls == ["beam", "2d", "2d", "beam", "2d"]
+    assert all("the scene's content differs" in r.stale for r in cmp.runs.values())
+    compare(scene_file, tmp_path / "e", results_root=tmp_path / "res", solvers=solvers,
             reuse=False)
-    assert len(calls) == 6
+    assert len(calls) == 7
+
+
+def test_without_a_results_root_everything_stays_in_the_output_folder(tmp_path, scene, synth):
+    cmp = compare(scene, tmp_path / "out", solvers=synth.fake_solvers(EPS))
+    assert {r.folder for r in cmp.runs.values()} == {tmp_path / "out" / "beam",
+                                                     tmp_path / "out" / "2d"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "scene.toml"]
 
 
 def test_missing_model_is_reported_in_words(tmp_path, scene, synth, monkeypatch):
-    monkeypatch.setitem(runs_module.MODEL_SOURCES, "beam",
-                        ("no_such_beam_module_xyz", ("beam_element",)))
+    import dataclasses
+
+    from models import registry
+
+    def unimportable(scene, progress=None):
+        raise ModuleNotFoundError("No module named 'no_such_beam_module_xyz'")
+
+    monkeypatch.setitem(registry.MODELS, "beam",
+                        dataclasses.replace(registry.MODELS["beam"], solve=unimportable))
     solvers = synth.fake_solvers(EPS)
     del solvers["beam"]
     events = []
@@ -112,7 +134,7 @@ def test_missing_model_is_reported_in_words(tmp_path, scene, synth, monkeypatch)
     data = _strict_json(tmp_path / "out" / "metrics.json")
     assert data["complete"] is False
     assert data["models"]["beam"]["origin"] == "missing"
-    assert "cannot import no_such_beam_module_xyz" in data["models"]["beam"]["reason"]
+    assert "cannot import" in data["models"]["beam"]["reason"]
     assert data["curves"] == [] and data["wall_ratio"] is None
     assert any("beam" in n for n in data["notes"])
     assert (tmp_path / "out" / "load_w_top_mid.png").is_file()  # the 2D path is still drawn
@@ -131,57 +153,53 @@ def test_failing_model_is_reported_and_comparison_goes_on(tmp_path, scene, synth
     assert cmp.runs["beam"].origin == "run"
 
 
-def _strip_snapshot(model, nx=31, nz=5):
+def _strip_frame(step=150, nx=31, nz=5, per_cell=True):
     x, z = np.meshgrid(np.linspace(0, 300, nx), np.linspace(0, 26, nz))
     pts = np.column_stack([x.ravel(), z.ravel()])
-    cells = [[j * nx + i, j * nx + i + 1, (j + 1) * nx + i + 1, (j + 1) * nx + i]
-             for j in range(nz - 1) for i in range(nx - 1)]
+    cells = np.array([[j * nx + i, j * nx + i + 1, (j + 1) * nx + i + 1, (j + 1) * nx + i]
+                      for j in range(nz - 1) for i in range(nx - 1)])
     disp = np.column_stack([np.zeros(len(pts)), -10 * np.sin(np.pi * pts[:, 0] / 300)])
-    vm = np.abs(np.cos(np.pi * pts[:, 0] / 300))
-    region = np.zeros(len(cells), dtype=int)
+    region = np.zeros(len(cells))
     region[-(nx - 1):] = 1  # the top row of cells is the top face (drawn grey)
-    return FieldSnapshot(model, 150, 1.0, pts, disp, np.array(cells), vm, region)
+    vm = np.abs(np.cos(np.pi * pts[:, 0] / 300))
+    if per_cell:
+        return FieldFrame(step, 1.0, pts, cells, disp, {},
+                          {"von_mises": vm[cells].mean(axis=1), "region": region})
+    return FieldFrame(step, 1.0, pts, cells, disp, {"von_mises": vm}, {"region": region})
 
 
-def test_field_snapshot_is_rendered_when_a_model_provides_it(tmp_path, scene, synth):
+def test_deformed_pictures_come_from_each_models_field_frames(tmp_path, scene, synth):
     solvers = synth.fake_solvers(EPS)
-    inner = solvers["2d"]
+    inner = dict(solvers)
 
-    def with_fields(scene, progress=None):
-        sol = inner(scene, progress)
-        sol.extra["field_snapshot"] = _strip_snapshot("2d")  # noqa: B023
-        return sol
+    def with_frames(model, per_cell):
+        def solve(scene, progress=None):
+            sol = inner[model](scene, progress)
+            sol.fields = [_strip_frame(1, per_cell=per_cell), _strip_frame(per_cell=per_cell)]
+            return sol
+        return solve
 
-    solvers["2d"] = with_fields
-    # the in-memory snapshot goes to fields.npz (summary.json cannot hold arrays)
-    cmp = compare(scene, tmp_path / "o0", results_root=tmp_path / "r0", solvers=solvers)
-    assert (tmp_path / "r0" / scene.name / "2d" / "fields.npz").is_file()
-    assert "field_snapshot" not in (tmp_path / "r0" / scene.name / "2d" / "summary.json"
-                                    ).read_text()
-    assert tmp_path / "o0" / "deformed_2d.png" in cmp.figures
-    # a snapshot saved next to a result (as a model would) is used too
-    save_snapshot(_strip_snapshot("beam"), tmp_path / "res" / scene.name / "beam")
+    solvers = {"2d": with_frames("2d", True), "beam": with_frames("beam", False)}
+    cmp = compare(scene, tmp_path / "o0", results_root=tmp_path / "res", solvers=solvers)
+    for model in ("2d", "beam"):
+        png = tmp_path / "o0" / f"deformed_{model}.png"
+        assert png in cmp.figures and png.stat().st_size > 5000
+        assert (tmp_path / "res" / scene.name / model / "fields_00150.vtu").is_file()
+    assert not (tmp_path / "o0" / "deformed_faces.png").exists()  # no profile fallback needed
+    # reused: the pictures come from the frames read back from the result folders
+    cmp = compare(scene, tmp_path / "o1", results_root=tmp_path / "res", solvers=solvers)
+    assert {r.origin for r in cmp.runs.values()} == {"reused"}
+    assert [f.step for f in cmp.runs["2d"].solution.fields] == [1, 150]
+    assert (tmp_path / "o1" / "deformed_2d.png").stat().st_size > 5000
+    # a model without frames is drawn from its profiles
     plain = synth.fake_solvers(EPS)
-    compare(scene, tmp_path / "x", results_root=tmp_path / "res", solvers=plain)
-    # ... but a rerun that gives no snapshot removes the stale one
-    assert not (tmp_path / "res" / scene.name / "beam" / "fields.npz").exists()
-    save_snapshot(_strip_snapshot("beam"), tmp_path / "res" / scene.name / "beam")
-    old = (tmp_path / "res" / scene.name / "beam" / "summary.json").stat().st_mtime - 100
-    import os
-
-    os.utime(scene.source, (old, old))
-    cmp = compare(scene, tmp_path / "out", results_root=tmp_path / "res", solvers=plain)
-    assert cmp.runs["beam"].origin == "reused"
-    assert tmp_path / "out" / "deformed_beam.png" in cmp.figures
-    assert (tmp_path / "out" / "deformed_beam.png").stat().st_size > 5000
-    assert (tmp_path / "out" / "deformed_faces.png").is_file()  # 2D still from its profiles
+    cmp = compare(scene, tmp_path / "o2", results_root=tmp_path / "res2", solvers=plain)
+    assert (tmp_path / "o2" / "deformed_faces.png").is_file()
+    assert not (tmp_path / "o2" / "deformed_2d.png").exists()
 
 
-def test_field_snapshot_refuses_inconsistent_arrays():
-    snap = _strip_snapshot("2d")
-    with pytest.raises(ValueError, match="von_mises"):
-        FieldSnapshot("2d", 1, 1.0, snap.points, snap.displacement, snap.cells,
-                      snap.von_mises[:7])
-    with pytest.raises(ValueError, match="outside"):
-        FieldSnapshot("2d", 1, 1.0, snap.points, snap.displacement, snap.cells + 10_000,
-                      snap.von_mises)
+def test_a_frame_without_stress_is_refused_in_words():
+    frame = _strip_frame()
+    frame.cell_data.pop("von_mises")
+    with pytest.raises(ValueError, match="no von_mises"):
+        picture_of("2d", frame)

@@ -1,10 +1,9 @@
-"""Round trip: sandwich.results.write_solution → comparisons.load_result."""
+"""Round trip: sandwich.results.write_solution → sandwich.results.load_result."""
 
 import numpy as np
 import pytest
 
-from comparisons import ResultMissing, load_result
-from sandwich.results import write_solution
+from sandwich.results import ResultMissing, load_result, write_solution
 
 
 def test_round_trip_keeps_every_field(tmp_path, synth):

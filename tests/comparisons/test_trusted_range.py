@@ -38,26 +38,16 @@ load level). Three parts:
    10 % relative L2 over the common range). Reference: the 2D model.
 """
 
-import importlib.util
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from beam_element import run
-from sandwich.scene import (
-    Analysis,
-    BeamModelOptions,
-    Layer,
-    Load,
-    Material,
-    Probe,
-    Scene,
-    Support,
-    load_scene,
-)
+from sandwich.scene import Analysis, BeamModelOptions, Layer, Load, Material, Probe, Scene, Support
+from sandwich.scene_file import load_scene
+from studies import extremes
 
 ROOT = Path(__file__).resolve().parents[2]
 E_FACE, NU_FACE = 27420.0, 0.3  # the fig5 scene's kevlar faces
@@ -135,19 +125,9 @@ def test_thick_face_theory_reduces_to_the_classical_formula():
 
 # -- nonlinear: the sweep's scenes -----------------------------------------------------------------
 
-def _extremes():
-    spec = importlib.util.spec_from_file_location("bench_extremes_trusted",
-                                                  ROOT / "benchmarks" / "extremes.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
-
-
 def sweep_scene(sweep: str, value: float) -> Scene:
-    ext = _extremes()
-    base = load_scene(ROOT / "scenes" / f"{ext.BASE}.toml")
-    return next(sc for sw, v, sc in ext.cases(base, [sweep]) if math.isclose(v, value))
+    base = load_scene(ROOT / "scenes" / f"{extremes.BASE}.toml")
+    return next(sc for sw, v, sc in extremes.cases(base, [sweep]) if math.isclose(v, value))
 
 
 def _assert_reaches_target(scene: Scene, sol) -> None:
@@ -201,7 +181,7 @@ def test_beam_agrees_with_2d_at_the_edges_of_the_map(sweep, value, tol, common):
     beam = run(scene, elements=MAP_ELEMENTS).solution
     _assert_reaches_target(scene, beam)
     ref = reference2d.solve(scene, level=MAP_LEVEL)
-    agree = _extremes().agreement(scene, beam, ref)
+    agree = extremes.agreement(scene, beam, ref)
     assert agree["common"] >= common - 1e-3, agree
     assert agree["load_l2"] <= tol, agree
 

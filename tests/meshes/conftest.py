@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from meshes import build_mesh
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 FIG5 = SCENES / "paper-fig5-top-debond-40-load-top.toml"

@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from meshes import build_mesh, write_mesh
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 

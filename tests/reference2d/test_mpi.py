@@ -73,7 +73,7 @@ def _serial_and_two_ranks(scene: Path, tmp_path: Path) -> tuple[Path, Path]:
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     env.setdefault("XDG_CACHE_HOME", str(ROOT / ".cache"))
     env["XDG_CACHE_HOME"] = str(Path(env["XDG_CACHE_HOME"]).resolve())  # ranks change cwd
-    args = ["-m", "sandwich.cli", "solve", str(scene), "--model", "2d", "--level", "coarse",
+    args = ["-m", "sandwich_cli", "solve", str(scene), "--model", "2d", "--level", "coarse",
             "--quiet"]
     serial = tmp_path / "serial"
     _run([sys.executable, *args, "--out", str(serial)], env)

@@ -9,7 +9,7 @@ import pytest
 from r2d_structured import layered_mesh
 
 from reference2d import solve
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
 

@@ -8,7 +8,7 @@ import pytest
 
 from reference2d import solve, write_fields
 from sandwich.results import PROFILE_COLUMNS, write_solution
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
 

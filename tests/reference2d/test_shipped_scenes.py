@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from reference2d import solve
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
 

@@ -18,7 +18,7 @@ from meshes import build_mesh
 from reference2d.mesh import input_node_blocks
 from reference2d.model import build_model, face_band
 from reference2d.solve import solve
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
 

@@ -1,16 +1,18 @@
 """The assembled tangent (UFL derivative + contact Hessian) against finite differences."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
 from r2d_structured import layered_mesh
 
 from reference2d.model import build_model
-from sandwich.scene import load_scene
+from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
 
-SCENES = __import__("pathlib").Path(__file__).resolve().parents[2] / "scenes"
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
 
 def _mult(K, d):

@@ -1,8 +1,8 @@
-"""Read a result folder (``history.csv``, ``profiles.csv``, ``summary.json``) back into a Solution.
+"""Read a result folder (``history.csv``, ``profiles.csv``, ``summary.json``, field frames) back.
 
-This is the inverse of :func:`sandwich.results.write_solution`: whatever a model wrote, the
-harness reads back into the same typed :class:`~sandwich.results.Solution` it would have
-received in memory.
+This is the inverse of :func:`sandwich.results.writing.write_solution`: whatever a model wrote
+is read back into the same typed :class:`~sandwich.results.types.Solution` it would have
+returned in memory, field frames (``fields.pvd`` + VTU) included.
 """
 
 from __future__ import annotations
@@ -14,9 +14,18 @@ from pathlib import Path
 
 import numpy as np
 
-from sandwich.results import PROFILE_COLUMNS, LimitPoint, Profile, Solution, StepRecord
+from sandwich.results.types import (
+    PROFILE_COLUMNS,
+    FieldFrame,
+    LimitPoint,
+    Profile,
+    Solution,
+    StepRecord,
+)
+from sandwich.results.vtu import read_pvd, read_vtu
 
 RESULT_FILES = ("history.csv", "profiles.csv", "summary.json")
+FIELDS_COLLECTION = "fields.pvd"
 _SUMMARY_KEYS = {"model", "scene", "converged", "message", "steps", "final_load_factor",
                  "limit_points", "wall_seconds", "dofs"}
 
@@ -81,13 +90,15 @@ def _read_profiles(path: Path) -> list[Profile]:
     return profiles
 
 
-def load_result(folder: str | Path) -> Solution:
+def load_result(folder: str | Path, *, fields: bool = True) -> Solution:
     """Read the result files in ``folder`` into a :class:`~sandwich.results.Solution`.
 
     Parameters
     ----------
     folder
         A folder written by :func:`sandwich.results.write_solution`.
+    fields
+        Also read the field frames (``fields.pvd`` and its VTU files) when there are any.
 
     Returns
     -------
@@ -124,4 +135,26 @@ def load_result(folder: str | Path) -> Solution:
         wall_seconds=_float(summary.get("wall_seconds")),
         dofs=int(summary.get("dofs", 0) or 0),
         extra={k: v for k, v in summary.items() if k not in _SUMMARY_KEYS},
+        fields=read_field_frames(folder) if fields else [],
     )
+
+
+def read_field_frames(folder: str | Path) -> list[FieldFrame]:
+    """The field frames of a result folder (``fields.pvd`` + VTU), ``[]`` when it has none.
+
+    The step comes from the file name ``fields_NNNNN.vtu``, the load factor from the
+    collection's time value; ``displacement`` is taken out of the point data.
+    """
+    pvd = Path(folder) / FIELDS_COLLECTION
+    if not pvd.is_file():
+        return []
+    frames = []
+    for load_factor, name in read_pvd(pvd):
+        points, cells, point_data, cell_data = read_vtu(pvd.parent / name)
+        if "displacement" not in point_data:
+            raise ValueError(f"{pvd.parent / name}: no displacement point data")
+        disp = point_data.pop("displacement")[:, :2]
+        step = int(Path(name).stem.rsplit("_", 1)[-1])
+        frames.append(FieldFrame(step, load_factor, points[:, :2], cells, disp,
+                                 point_data, cell_data))
+    return frames

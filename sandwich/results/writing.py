@@ -1,6 +1,6 @@
-"""Typed results every model returns, and their writers (the result-file contract).
+"""Writers of the result-file contract.
 
-A solve writes, atomically, into its folder:
+A solve writes, as one set (:func:`write_solution`), into its folder:
 
 - ``history.csv``: one row per converged step,
   ``step, load_factor, <one column per probe (mm)>, iterations[, more columns]``;
@@ -18,85 +18,17 @@ import io
 import json
 import math
 import os
+import re
+import shutil
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-PROFILE_COLUMNS = ("x", "w_top", "w_bottom", "sigma_zz_top", "sigma_zz_bottom", "tau_core")
+from sandwich.results.types import PROFILE_COLUMNS, FieldFrame, Solution
+from sandwich.results.vtu import pvd_text, vtu_text
 
-
-@dataclass
-class StepRecord:
-    """One converged equilibrium state on the path."""
-
-    step: int
-    load_factor: float
-    probes: dict[str, float]
-    iterations: int
-    extra: dict[str, float] = field(default_factory=dict)
-
-
-@dataclass
-class Profile:
-    """Fields sampled along the beam axis at one converged step (mm, MPa).
-
-    ``columns`` holds at least the names of ``PROFILE_COLUMNS`` (each an array over ``x``);
-    models may add more (``p_contact_top``, ``u_top`` ...).
-    """
-
-    step: int
-    columns: dict[str, np.ndarray]
-
-
-@dataclass
-class LimitPoint:
-    """An extremum of the load factor along the path, or a bifurcation (tangent inertia change)."""
-
-    kind: str  # "max" | "min" | "bifurcation"
-    step: int
-    load_factor: float
-    probes: dict[str, float]
-
-
-@dataclass
-class FieldFrame:
-    """Fields of one converged step on a 2D grid of the beam, for ParaView.
-
-    ``points`` are reference coordinates (x, z) in mm, ``cells`` counter-clockwise quads (m, 4) or
-    triangles (m, 3); ``displacement`` (n, 2) in mm; stresses in MPa as point or cell data.
-    """
-
-    step: int
-    load_factor: float
-    points: np.ndarray
-    cells: np.ndarray
-    displacement: np.ndarray
-    point_data: dict[str, np.ndarray] = field(default_factory=dict)
-    cell_data: dict[str, np.ndarray] = field(default_factory=dict)
-
-
-@dataclass
-class Solution:
-    """What a solve returns: the equilibrium path, profiles and a summary."""
-
-    model: str
-    scene: str
-    history: list[StepRecord]
-    profiles: list[Profile]
-    converged: bool
-    message: str
-    limit_points: list[LimitPoint]
-    wall_seconds: float
-    dofs: int
-    extra: dict[str, object] = field(default_factory=dict)
-    fields: list[FieldFrame] = field(default_factory=list)
-
-    @property
-    def final_load_factor(self) -> float:
-        """Load factor of the last converged step (0 when none converged)."""
-        return self.history[-1].load_factor if self.history else 0.0
+RESULT_SET_NAMES = frozenset({"history.csv", "profiles.csv", "summary.json", "fields.pvd"})
 
 
 def _finite(value: float) -> float | None:
@@ -109,8 +41,9 @@ def atomic_write_text(path: Path, text: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", newline="") as fh:
+        with os.fdopen(fd, "w", newline="", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, 0o666 & ~_umask())  # as a plain open() would (mkstemp makes 0600)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -186,9 +119,8 @@ def summary_dict(solution: Solution) -> dict[str, object]:
     return out
 
 
-def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
-    """Write the three result files of ``solution`` into ``out_dir``; return their paths."""
-    out_dir = Path(out_dir)
+def result_texts(solution: Solution) -> dict[str, str]:
+    """Every file of ``solution``'s result set, by name (refuses non-finite values first)."""
     files = {
         "history.csv": history_csv(solution),
         "profiles.csv": profiles_csv(solution),
@@ -196,17 +128,99 @@ def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
     }
     if solution.fields:
         files.update(_field_files(solution.fields))
-    paths = []
-    for name, text in files.items():
-        atomic_write_text(out_dir / name, text)
-        paths.append(out_dir / name)
-    return paths
+    return files
+
+
+def is_result_file(name: str) -> bool:
+    """Whether ``name`` is one a result set may hold (so a rerun may replace it)."""
+    return name in RESULT_SET_NAMES or bool(re.fullmatch(r"fields_\d+\.vtu", name))
+
+
+def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
+    """Write the result set of ``solution`` into ``out_dir`` as a whole; return its paths.
+
+    The files are written into a temporary sibling folder which then takes the place of
+    ``out_dir``: a reader sees the old set or the new one, never a mix (an older run's VTU
+    frames do not survive a rerun). A folder that holds files other than result files (a user's
+    folder given as ``--out``) keeps them: the result files are then replaced one by one, and
+    result files of the old set that the new one lacks are removed.
+
+    Raises
+    ------
+    ValueError
+        If a value is not finite (nothing is written then).
+    OutputError
+        If ``out_dir`` cannot be a result folder (see :func:`check_output_folder`).
+    """
+    out_dir = Path(out_dir)
+    files = result_texts(solution)
+    check_output_folder(out_dir)
+    out_dir = Path(os.path.abspath(out_dir))
+    foreign = out_dir.is_dir() and any(not is_result_file(f.name) and not f.name.startswith(".")
+                                       for f in out_dir.iterdir())
+    if foreign or out_dir == Path(os.getcwd()):  # never swap away the folder we stand in
+        for old in out_dir.iterdir():
+            if is_result_file(old.name) and old.name not in files:
+                old.unlink()
+        for name, text in files.items():
+            atomic_write_text(out_dir / name, text)
+        return [out_dir / n for n in files]
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}.new-"))
+    try:
+        for name, text in files.items():
+            _write_file(tmp / name, text)
+        if out_dir.exists():
+            old = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}.old-"))
+            os.replace(out_dir, old / out_dir.name)
+            os.replace(tmp, out_dir)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, out_dir)
+        os.chmod(out_dir, 0o777 & ~_umask())
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return [out_dir / n for n in files]
+
+
+class OutputError(OSError):
+    """A result folder that cannot be written: where and why."""
+
+
+def check_output_folder(folder: Path) -> None:
+    """Refuse, before any work, a folder that cannot take a result set.
+
+    Raises :class:`OutputError` when ``folder`` (or its nearest existing parent) is a file, or
+    is not writable.
+    """
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"{folder}: exists and is not a folder")
+    probe = folder
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise OutputError(f"{folder}: {probe} is not a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise OutputError(f"{folder}: {probe} is not writable")
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _write_file(path: Path, text: str) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        fh.write(text)
 
 
 def _field_files(frames: list[FieldFrame]) -> dict[str, str]:
     """VTU per frame plus a ``fields.pvd`` collection (time = load factor)."""
-    from sandwich.vtu import pvd_text, vtu_text
-
     out: dict[str, str] = {}
     entries = []
     for frame in frames:

@@ -1,0 +1,86 @@
+"""Typed results every model returns (the result contract's in-memory side).
+
+:class:`Solution` holds the equilibrium path (:class:`StepRecord` per converged step), profiles
+along the beam (:class:`Profile`), limit points and, when the model reconstructs them, 2D field
+frames (:class:`FieldFrame`, the one field type both models fill).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+PROFILE_COLUMNS = ("x", "w_top", "w_bottom", "sigma_zz_top", "sigma_zz_bottom", "tau_core")
+
+
+@dataclass
+class StepRecord:
+    """One converged equilibrium state on the path."""
+
+    step: int
+    load_factor: float
+    probes: dict[str, float]
+    iterations: int
+    extra: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class Profile:
+    """Fields sampled along the beam axis at one converged step (mm, MPa).
+
+    ``columns`` holds at least the names of ``PROFILE_COLUMNS`` (each an array over ``x``);
+    models may add more (``p_contact_top``, ``u_top`` ...).
+    """
+
+    step: int
+    columns: dict[str, np.ndarray]
+
+
+@dataclass
+class LimitPoint:
+    """An extremum of the load factor along the path, or a bifurcation (tangent inertia change)."""
+
+    kind: str  # "max" | "min" | "bifurcation"
+    step: int
+    load_factor: float
+    probes: dict[str, float]
+
+
+@dataclass
+class FieldFrame:
+    """Fields of one converged step on a 2D grid of the beam, for ParaView.
+
+    ``points`` are reference coordinates (x, z) in mm, ``cells`` counter-clockwise quads (m, 4) or
+    triangles (m, 3); ``displacement`` (n, 2) in mm; stresses in MPa as point or cell data.
+    """
+
+    step: int
+    load_factor: float
+    points: np.ndarray
+    cells: np.ndarray
+    displacement: np.ndarray
+    point_data: dict[str, np.ndarray] = field(default_factory=dict)
+    cell_data: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass
+class Solution:
+    """What a solve returns: the equilibrium path, profiles and a summary."""
+
+    model: str
+    scene: str
+    history: list[StepRecord]
+    profiles: list[Profile]
+    converged: bool
+    message: str
+    limit_points: list[LimitPoint]
+    wall_seconds: float
+    dofs: int
+    extra: dict[str, object] = field(default_factory=dict)
+    fields: list[FieldFrame] = field(default_factory=list)
+
+    @property
+    def final_load_factor(self) -> float:
+        """Load factor of the last converged step (0 when none converged)."""
+        return self.history[-1].load_factor if self.history else 0.0

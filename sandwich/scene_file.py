@@ -1,0 +1,46 @@
+"""Read a scene file: TOML text → the checks of :mod:`sandwich.scene_checks` → a typed Scene."""
+
+from __future__ import annotations
+
+import stat
+import tomllib
+from pathlib import Path
+
+from sandwich.scene import Problem, Scene, SceneError
+from sandwich.scene_checks import build_scene
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read, check and return the scene in ``path``; raise :class:`SceneError` if it is bad.
+
+    Every way a file can fail to be a scene is a :class:`SceneError` naming the file and the
+    reason: absent, not a regular file (a folder, a FIFO, a symlink loop), unreadable, not UTF-8
+    (a UTF-8 byte-order mark is accepted), not TOML, nested too deeply, or a scene the checks
+    refuse.
+    """
+    path = Path(path)
+    fname = str(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise SceneError([Problem(fname, "-", "no such file")]) from None
+    except OSError as exc:  # a symlink loop, a name too long
+        raise SceneError([Problem(fname, "-", f"cannot be read ({exc.strerror or exc})")]) from None
+    if not stat.S_ISREG(mode):
+        raise SceneError([Problem(fname, "-", "not a regular file")])
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:  # no permission, an I/O error
+        raise SceneError([Problem(fname, "-", f"cannot be read ({exc.strerror or exc})")]) from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8-sig"))
+    except UnicodeDecodeError as exc:
+        raise SceneError([Problem(fname, "-", f"not UTF-8 text ({exc.reason})")]) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError([Problem(fname, "-", f"not valid TOML: {exc}")]) from None
+    except RecursionError:
+        raise SceneError([Problem(fname, "-", "nested too deeply to be a scene")]) from None
+    try:
+        return build_scene(data, fname, source=path)
+    except RecursionError:
+        raise SceneError([Problem(fname, "-", "nested too deeply to be a scene")]) from None
