@@ -25,7 +25,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from sandwich.scene import load_scene  # noqa: E402
+from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "fracture"
 SCENES = {"fig5": "paper-fig5-top-debond-40-load-top", "c2": "paper-fig7-cantilever-c2",

@@ -142,7 +142,7 @@ def test_j_integral_equals_vcct_along_the_fig5_buckling_path():
     from reference2d.fracture import VcctEvaluator
     from reference2d.jintegral import JIntegral
     from reference2d.solve import solve
-    from sandwich.scene import load_scene
+    from sandwich.scene_file import load_scene
 
     root = __import__("pathlib").Path(__file__).resolve().parents[2]
     sc = load_scene(root / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
