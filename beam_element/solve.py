@@ -26,6 +26,7 @@ from beam_element.core_levels import (
     zone_levels,
 )
 from beam_element.fields import profile_columns, section_fields
+from beam_element.fracture import beam_tips, history_columns, level_warning, tip_releases
 from beam_element.model import BeamModel, beam_mesh, build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
@@ -265,6 +266,9 @@ def run(
                         f"{bm.max_core_level}, {CORE_RECHECKS} reruns)")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
+    solution.extra.update(_growth_summary(scene, solution))
+    if level_warning(model, beam_tips(scene, model)):
+        solution.extra["G_warning"] = level_warning(model, beam_tips(scene, model))
     solution.extra["core"] = {
         "how": choice.how, "basis": options["core_basis"],
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,
@@ -273,6 +277,14 @@ def run(
     }
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _growth_summary(scene: object, solution: Solution) -> dict[str, object]:
+    """Summary entry of the debond growth criterion (debonds with a toughness only)."""
+    from sandwich.fracture import growth_onset
+
+    onset = growth_onset(scene, solution.history)
+    return {"debond_growth": onset} if onset else {}
 
 
 def choose_core_levels(scene: object, elements: int | None, options: dict) -> LevelChoice:
@@ -416,13 +428,15 @@ def _solution(
 ) -> Solution:
     history = []
     max_pen = max_slide = 0.0
+    tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
     for s in states:
         summary = model.contact_summary(s.u) if nonlinear else {}
         pen = max((c.max_penetration for c in summary.values()), default=0.0)
         slide = max((c.max_sliding for c in summary.values()), default=0.0)
         max_pen, max_slide = max(max_pen, pen), max(max_slide, slide)
         extra = {"max_penetration": pen, "max_sliding": slide,
-                 "contact_pairs_active": float(sum(c.active for c in summary.values()))}
+                 "contact_pairs_active": float(sum(c.active for c in summary.values())),
+                 **history_columns(tip_releases(model, s.u, tips))}
         history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
                                   iterations=s.iterations, extra=extra))
     every = int(getattr(getattr(scene, "beam_model", None), "profile_every", 0) or 0)

@@ -6,8 +6,10 @@ import time
 
 import numpy as np
 
+from reference2d.fracture import VcctEvaluator, history_columns
 from reference2d.model import Model2D, build_model
 from reference2d.profiles import ProfileSampler
+from sandwich.fracture import growth_onset
 from sandwich.results import Profile, Solution, StepRecord
 from sandwich.scene import Scene
 from sandwich.solver.path import PathOptions, PathState, follow_path, solve_linear
@@ -23,7 +25,8 @@ def build_scene_mesh(scene: Scene, level: str | None = None, refine: int | None 
 
 
 def solve(scene: Scene, progress=None, level: str | None = None, refine: int | None = None,
-          mesh=None, penalty: float | None = None, keep_states: bool = False) -> Solution:
+          mesh=None, penalty: float | None = None, keep_states: bool = False,
+          closure_length: float | None = None) -> Solution:
     """Solve ``scene`` with the 2D plane-stress reference.
 
     Parameters
@@ -38,6 +41,10 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         A ready ``LayeredMesh`` (or an object with its arrays) instead of building one.
     penalty
         Contact penalty (N/mm³) instead of the scene's or the default.
+    closure_length
+        VCCT closure length Δ (mm) of the energy release rate at the debond tips
+        (:mod:`reference2d.fracture`); default ``[reference2d] closure_length``, else the
+        thinner face's thickness.
     keep_states
         Keep the model and the displacement vector of every converged state on the returned
         solution (attribute ``reference2d_states``) for :func:`reference2d.write_fields`.
@@ -54,6 +61,8 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
                               root=0)
     model = build_model(scene, mesh, penalty=penalty)
     system = model.system
+    vcct = VcctEvaluator(model, closure_length if closure_length is not None
+                         else scene.reference2d.closure_length)
     names = [p.name for p in scene.probes]
     a = scene.analysis
     rows: list[StepRecord] = []
@@ -66,6 +75,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
                  "cuts": float(state.cuts)}
         if state.negative_pivots is not None:
             extra["negative_pivots"] = float(state.negative_pivots)
+        extra.update(history_columns(vcct.evaluate(state.u)))  # G at the debond tips, N/mm
         rows.append(StepRecord(state.step, float(state.load_factor),
                                {n: float(state.probes[n]) for n in names},
                                int(state.iterations), extra))
@@ -107,7 +117,17 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "newton_iterations": int(sum(r.iterations for r in rows)),
         "stress_measure": "second Piola-Kirchhoff, reference frame",
         "mpi_ranks": int(model.disc.mesh.comm.size),
+        "vcct_closure_length": float(vcct.closure_length),
+        "vcct_closure_over_tip_element": (float(vcct.closure_over_element)
+                                          if vcct.tips else None),
     }
+    if vcct.supported_tips():
+        extra["G_warning"] = (f"a support acts within the closure length ahead of tip(s) "
+                              f"{', '.join(vcct.supported_tips())}: its reaction enters the "
+                              "VCCT force, G there is not reliable")
+    onset = growth_onset(scene, rows)  # debonds with a toughness: first step G >= G_c
+    if onset:
+        extra["debond_growth"] = onset
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)

@@ -91,12 +91,25 @@ class Layer:
 
 
 @dataclass(frozen=True)
+class Toughness:
+    """Interface toughness of a debond (N/mm) for the Benzeggagh–Kenane criterion.
+
+    Growth when G ≥ G_c = GIc + (GIIc − GIc) (G_II / G)^eta (:mod:`sandwich.fracture`).
+    """
+
+    GIc: float
+    GIIc: float
+    eta: float = 2.0  # Benzeggagh–Kenane exponent
+
+
+@dataclass(frozen=True)
 class Debond:
     """A debonded stretch [start, end] (mm) of the top or bottom face/core interface."""
 
     interface: str
     start: float
     end: float
+    toughness: Toughness | None = None  # optional: report the first step where it grows
 
     @property
     def length(self) -> float:
@@ -200,6 +213,7 @@ class Reference2DOptions:
     half_model: bool = False
     contact_penalty: float | None = None
     profile_every: int = 0
+    closure_length: float | None = None  # VCCT closure length (mm); None: the thinner face
 
 
 @dataclass(frozen=True)

@@ -37,6 +37,7 @@ from sandwich.scene import (
     Scene,
     SceneError,
     Support,
+    Toughness,
     is_finite_number,
 )
 
@@ -312,7 +313,8 @@ def _debonds(r: Reader, arr: Any, L: float | None) -> list[Debond]:
     out: list[tuple[int, Debond]] = []
     for i, d in enumerate(r.array_of_tables(arr, "debonds")):
         key = f"debonds[{i}]"
-        t = r.table(d, key, ("interface", "start", "end"), required=("interface", "start", "end"))
+        t = r.table(d, key, ("interface", "start", "end", "toughness"),
+                    required=("interface", "start", "end"))
         if t is None:
             continue
         itf = r.choice(t, "interface", key, INTERFACES)
@@ -321,8 +323,9 @@ def _debonds(r: Reader, arr: Any, L: float | None) -> list[Debond]:
         if a is not None and b is not None and b < a:
             r.fail(f"{key}.end", f"end {b:g} is before start {a:g}")
             continue
+        tough = _toughness(r, t, key, a, b)
         if None not in (itf, a, b):
-            out.append((i, Debond(itf, a, b)))
+            out.append((i, Debond(itf, a, b, tough)))
     for itf in INTERFACES:
         same = sorted((x for x in out if x[1].interface == itf), key=lambda x: x[1].start)
         for (i, d1), (j, d2) in zip(same, same[1:], strict=False):
@@ -331,6 +334,26 @@ def _debonds(r: Reader, arr: Any, L: float | None) -> list[Debond]:
                        f"([{d1.start:g}, {d1.end:g}] and [{d2.start:g}, {d2.end:g}]); "
                        "merge them into one debond")
     return [d for _, d in out]
+
+
+def _toughness(r: Reader, t: dict[str, Any], key: str, a: float | None,
+               b: float | None) -> Toughness | None:
+    """``toughness = { GIc, GIIc, eta }`` of a debond (N/mm; eta the Benzeggagh–Kenane exponent)."""
+    if "toughness" not in t:
+        return None
+    key = f"{key}.toughness"
+    tt = r.table(t["toughness"], key, ("GIc", "GIIc", "eta"), required=("GIc", "GIIc"))
+    if tt is None:
+        return None
+    gic = r.number(tt, "GIc", key, positive=True)
+    giic = r.number(tt, "GIIc", key, positive=True)
+    eta = r.number(tt, "eta", key, default=2.0, positive=True)
+    if a is not None and b is not None and b - a <= GEOMETRY_TOL:
+        r.fail(key, "a zero-length debond is bonded: it has no tip whose growth to judge")
+        return None
+    if None in (gic, giic, eta):
+        return None
+    return Toughness(gic, giic, eta)
 
 
 def _supports(r: Reader, arr: Any, L: float | None) -> list[Support]:
@@ -506,7 +529,8 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
 def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
     key = "reference2d"
     t = r.table(tbl, key, ("level", "refine", "face_elements", "core_size", "face_size",
-                           "tip_size", "half_model", "contact_penalty", "profile_every"))
+                           "tip_size", "half_model", "contact_penalty", "profile_every",
+                           "closure_length"))
     if t is None:
         return Reference2DOptions()
     d = Reference2DOptions()
@@ -527,6 +551,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
         half_model=half,
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
         profile_every=r.integer(t, "profile_every", key, default=0, lo=0) or 0,
+        closure_length=r.number(t, "closure_length", key, default=None, positive=True),
         **sizes,
     )
 

@@ -130,7 +130,8 @@ def test_two_ranks_give_the_serial_history_and_profiles(tmp_path):
     """fig5 to w_top_mid = -1.5 mm: top lip pressed shut under the load at mid-span."""
     scene = _scene(tmp_path, "paper-fig5-top-debond-40-load-top", "-15", "-1.5", "fig5-mpi")
     serial, par = _serial_and_two_ranks(scene, tmp_path)
-    _, worst = _check_same(serial, par, ("load_factor", "w_top_mid", "w_bottom_mid"),
+    _, worst = _check_same(serial, par, ("load_factor", "w_top_mid", "w_bottom_mid",
+                                         "G_0_start", "G_0_end", "GII_0_start"),
                            ("x", "w_top", "w_bottom", "sigma_zz_top", "sigma_zz_bottom",
                             "tau_core", "p_contact_top"), min_rows=5)
     print(f"fig5: worst relative history difference {worst:.2e}")

@@ -1,0 +1,171 @@
+"""G along the path at every debond tip, beam vs 2D, on fig5 and the c2/c3 cantilevers.
+
+For each scene both models follow the scene's own path; each converged step's history holds
+``G_<debond>_<tip>``, ``GI_…``, ``GII_…`` (N/mm). The table compares them at common values of the
+scene's until-probe (interpolation of √G in each model's path, within the range both reached);
+the plot overlays G, G_I and G_II against that probe. The 2D model also reports the domain
+J-integral (``reference2d.jintegral``, disc of 4 face thicknesses) as a cross-check of its G.
+
+Run: ``XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/fracture_paths.py [--level medium]
+[--scenes fig5 c2 c3]``. Writes ``benchmarks/results/fracture/<scene>_<level>.md``, ``.csv`` and
+``.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from sandwich.scene_file import load_scene  # noqa: E402
+
+OUT = ROOT / "benchmarks" / "results" / "fracture"
+SCENES = {"fig5": "paper-fig5-top-debond-40-load-top", "c2": "paper-fig7-cantilever-c2",
+          "c3": "paper-fig7-cantilever-c3"}
+SAMPLES = 8  # probe values compared in the table
+J_RADIUS_FACES = 4.0  # 2D J-integral disc radius / face thickness
+
+
+def _solve(scene, model: str, level: str):
+    if model == "beam":
+        from beam_element.solve import solve
+        return solve(scene)
+    from reference2d.fracture import VcctEvaluator
+    from reference2d.jintegral import JIntegral
+    from reference2d.model import interface_z
+    from reference2d.solve import solve
+
+    sol = solve(scene, level=level, keep_states=True)
+    model, states = sol.reference2d_states
+    radius = J_RADIUS_FACES * min(scene.top.thickness, scene.bottom.thickness)
+    for t in VcctEvaluator(model).tips:
+        j = JIntegral(model, t.x_tip, interface_z(scene, t.interface),
+                      1.0 if t.tip == "end" else -1.0, radius)
+        for r, (_, _, u) in zip(sol.history, states, strict=True):
+            r.extra[f"J_{t.debond}_{t.tip}"] = j.evaluate(u)
+    sol.extra["j_radius"] = radius
+    return sol
+
+
+def _tips(sol) -> list[str]:
+    return sorted({k[2:] for r in sol.history for k in r.extra if k.startswith("G_")})
+
+
+def _path(sol, probe: str, tip: str) -> tuple[np.ndarray, ...]:
+    w = np.array([r.probes[probe] for r in sol.history])
+    cols = [np.array([r.extra.get(f"{p}_{tip}", 0.0) for r in sol.history])
+            for p in ("G", "GI", "GII", "J")]
+    return (w, np.array([r.load_factor for r in sol.history]), *cols)
+
+
+def _interp_energy(x: float, xs: np.ndarray, g: np.ndarray) -> float:
+    """Interpolate an energy release rate in √|G| (exact where G ∝ w², the linear regime)."""
+    r = np.interp(x, xs, np.sign(g) * np.sqrt(np.abs(g)))
+    return float(np.sign(r) * r * r)
+
+
+def _monotone(path: tuple[np.ndarray, ...], sign: float) -> tuple[np.ndarray, ...]:
+    """The path up to where the probe first stops moving towards the target (a turn-back)."""
+    w = sign * path[0]
+    back = np.flatnonzero(np.diff(w) <= 0)
+    end = int(back[0]) + 1 if len(back) else len(w)
+    return tuple(c[:end] for c in path)
+
+
+def main() -> None:
+    """Solve, tabulate and plot."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--level", default="medium")
+    ap.add_argument("--scenes", nargs="+", default=list(SCENES))
+    args = ap.parse_args()
+    OUT.mkdir(parents=True, exist_ok=True)
+    load = os.getloadavg()[0]
+    for key in args.scenes:
+        scene = load_scene(ROOT / "scenes" / f"{SCENES[key]}.toml")
+        probe = scene.analysis.until_probe
+        sols, walls = {}, {}
+        for model in ("beam", "2d"):
+            t0 = time.perf_counter()
+            sols[model] = _solve(scene, model, args.level)
+            walls[model] = time.perf_counter() - t0
+        stem = OUT / f"{key}_{args.level}"
+        with open(f"{stem}.csv", "w", newline="") as fh:
+            wr = csv.writer(fh)
+            wr.writerow(["model", "tip", "step", "load_factor", probe, "G", "GI", "GII", "J"])
+            for model, sol in sols.items():
+                for tip in _tips(sol):
+                    w, lam, g, gi, gii, j = _path(sol, probe, tip)
+                    for k in range(len(w)):
+                        wr.writerow([model, tip, k, lam[k], w[k], g[k], gi[k], gii[k],
+                                     j[k] if model == "2d" else ""])
+        lines = [f"# G along the path: {scene.name}", "",
+                 f"Beam: {sols['beam'].extra.get('elements')} elements, closure = the element "
+                 f"behind the tip. 2D: level {args.level}, "
+                 f"{sols['2d'].extra.get('cells')} cells, VCCT closure length "
+                 f"{sols['2d'].extra.get('vcct_closure_length')} mm, J-integral disc radius "
+                 f"{sols['2d'].extra.get('j_radius')} mm. "
+                 f"Wall time beam {walls['beam']:.1f} s, 2D {walls['2d']:.1f} s "
+                 f"(load average {load:.2f} at the start).", "",
+                 f"Beam: {sols['beam'].message}", "", f"2D: {sols['2d'].message}", ""]
+        tips = sorted(set(_tips(sols["beam"])) & set(_tips(sols["2d"])))
+        sign = np.sign(scene.analysis.until_value)
+        for tip in tips:
+            pb = _monotone(_path(sols["beam"], probe, tip), sign)
+            p2 = _monotone(_path(sols["2d"], probe, tip), sign)
+            reach = min(sign * pb[0][-1], sign * p2[0][-1])
+            lines += [f"## tip {tip}", "", f"Compared up to {probe} = {sign * reach:.4g} mm "
+                      "(the shorter of the two paths before any turn-back of the probe).", "",
+                      f"| {probe} (mm) | λ beam | λ 2D | G beam | G 2D | beam/2D | "
+                      "GII/G beam | GII/G 2D | J 2D / G 2D |", "|" + "---|" * 9]
+            for w in sign * np.linspace(reach / SAMPLES, reach, SAMPLES):
+                row = []
+                for p in (pb, p2):
+                    row.append([np.interp(sign * w, sign * p[0], p[1]),
+                                *(_interp_energy(sign * w, sign * p[0], c) for c in p[2:])])
+                (lb, gb, _, giib, _), (l2, g2, _, gii2, j2) = row
+                ratio = f"{gb / g2:.3f}" if g2 > 0 else "-"
+                jr = f"{j2 / g2:.3f}" if g2 > 0 else "-"
+                lines.append(f"| {w:.3g} | {lb:.4g} | {l2:.4g} | {gb:.4g} | {g2:.4g} | "
+                             f"{ratio} | {giib / gb if gb > 0 else 0:.2f} | "
+                             f"{gii2 / g2 if g2 > 0 else 0:.2f} | {jr} |")
+            lines.append("")
+        Path(f"{stem}.md").write_text("\n".join(lines) + "\n")
+        _plot(scene, sols, probe, tips, f"{stem}.png")
+        print(f"{key}: wrote {stem}.md/.csv/.png")
+
+
+def _plot(scene, sols, probe, tips, path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, max(1, len(tips)), figsize=(6 * max(1, len(tips)), 4.2),
+                             squeeze=False)
+    for ax, tip in zip(axes[0], tips, strict=False):
+        for model, style in (("beam", "-"), ("2d", "--")):
+            w, _, g, gi, gii, j = _path(sols[model], probe, tip)
+            if model == "2d":
+                ax.plot(w, j, "C2:", label="J 2d")
+            ax.plot(w, g, "k" + style, label=f"G {model}")
+            ax.plot(w, gi, "C0" + style, label=f"G_I {model}")
+            ax.plot(w, gii, "C3" + style, label=f"G_II {model}")
+        ax.set_xlabel(f"{probe} (mm)")
+        ax.set_ylabel("G (N/mm)")
+        ax.set_title(f"{scene.name}: tip {tip}")
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
