@@ -5,6 +5,8 @@ state, derived there). The closure length Δ is a physical length: G must not de
 bimaterial split may).
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from fracture_cases import (
@@ -144,7 +146,7 @@ def test_j_integral_equals_vcct_along_the_fig5_buckling_path():
     from reference2d.solve import solve
     from sandwich.scene_file import load_scene
 
-    root = __import__("pathlib").Path(__file__).resolve().parents[2]
+    root = Path(__file__).resolve().parents[2]
     sc = load_scene(root / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
     sol = solve(sc, level="medium", keep_states=True)
     assert sol.converged, sol.message
