@@ -31,6 +31,7 @@ import numpy as np
 
 from beam_element.dofs import TIES, global_dof
 from beam_element.model import BeamModel
+from sandwich.results.fracture import TipRelease, column_names, history_columns  # noqa: F401
 
 TIE_ROLES = ("u", "w", "w,x")  # order of the pairs in dofs.TIES
 # Core levels (beam_element.core_levels) that change within this many elements of a tip bias G:
@@ -52,17 +53,6 @@ class BeamTip:
     closure_length: float  # mm, the element between node and behind
     ahead_length: float  # mm, the element on the bonded side
 
-
-@dataclass(frozen=True)
-class TipRelease:
-    """G and its split at one tip for one state (N/mm), with the closure length used (mm)."""
-
-    debond: int
-    tip: str
-    G: float
-    GI: float
-    GII: float
-    closure_length: float
 
 
 def beam_tips(scene: object, model: BeamModel) -> list[BeamTip]:
@@ -133,15 +123,3 @@ def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip]) -> list[T
     return out
 
 
-def column_names(debond: int, tip: str) -> tuple[str, str, str]:
-    """History columns of one tip: ``G_<debond>_<tip>``, ``GI_…``, ``GII_…`` (N/mm)."""
-    return (f"G_{debond}_{tip}", f"GI_{debond}_{tip}", f"GII_{debond}_{tip}")
-
-
-def history_columns(releases: list[TipRelease]) -> dict[str, float]:
-    """The history.csv columns of a list of tip results."""
-    cols: dict[str, float] = {}
-    for r in releases:
-        g, gi, gii = column_names(r.debond, r.tip)
-        cols.update({g: float(r.G), gi: float(r.GI), gii: float(r.GII)})
-    return cols

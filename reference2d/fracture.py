@@ -40,6 +40,7 @@ from petsc4py import PETSc
 
 from reference2d.constitutive import green_lagrange
 from reference2d.model import GEOM_TOL, Model2D, interface_z
+from sandwich.results.fracture import TipRelease, column_names, history_columns  # noqa: F401
 
 LAYER_OF_FACE = {"top": 2, "bottom": 0}  # PlaneStressStiffness.layer_index of the face bands
 JIT = {"cffi_extra_compile_args": ["-O2"]}
@@ -60,21 +61,6 @@ class TipGeometry:
     r_behind: np.ndarray  # (p,) distance behind the tip (mm)
 
 
-@dataclass(frozen=True)
-class TipRelease:
-    """G and its split at one tip for one state (N/mm), with the closure length used (mm)."""
-
-    debond: int
-    tip: str
-    G: float
-    GI: float
-    GII: float
-    closure_length: float
-
-
-def column_names(debond: int, tip: str) -> tuple[str, str, str]:
-    """History columns of one tip: ``G_<debond>_<tip>``, ``GI_…``, ``GII_…`` (N/mm)."""
-    return (f"G_{debond}_{tip}", f"GI_{debond}_{tip}", f"GII_{debond}_{tip}")
 
 
 def default_closure_length(scene) -> float:
@@ -259,11 +245,3 @@ class VcctEvaluator:
             out.append(TipRelease(t.debond, t.tip, gi + gii, gi, gii, delta_len))
         return out
 
-
-def history_columns(releases: list[TipRelease]) -> dict[str, float]:
-    """The history.csv columns of a list of tip results."""
-    cols = {}
-    for r in releases:
-        g, gi, gii = column_names(r.debond, r.tip)
-        cols.update({g: r.G, gi: r.GI, gii: r.GII})
-    return cols
