@@ -49,8 +49,13 @@ PENALTY_GROWTH = 2.0
 # "auto" core levels along a path: the last converged state says where the core wants more
 # levels (beam_element.core_levels.state_shares); the path is rerun with those raised and the
 # change of the end load is the estimate; reruns continue while it exceeds the tolerance, at most
-# CORE_RECHECKS times.
+# CORE_RECHECKS times. A rerun may take at most RERUN_STEP_FACTOR times the steps of the pass it
+# checks (at least RERUN_MIN_STEPS): a raised model that needs far more steps has met a path the
+# checked pass did not see (default scene, level 4 over the debond: a limit point at −6 mm the
+# 2D model does not have, 240+ steps), and the kept answer is then the checked pass, said so.
 CORE_RECHECKS = 3
+RERUN_STEP_FACTOR = 3
+RERUN_MIN_STEPS = 30
 
 
 @dataclass(frozen=True)
@@ -205,11 +210,26 @@ def run(
         converged = True
     else:
         previous: ConvergedState | None = None
+        kept: tuple | None = None  # the last pass that reached the target, and its levels
+        stopped_rerun = ""
         for recheck in range(CORE_RECHECKS + 1):
-            model, states, message, converged, limit_points, raised = _follow_penalised(
-                scene, elements, {**options, "core_level": choice.levels}, progress)
+            budget = None if kept is None else min(
+                int(a.max_steps), max(RERUN_MIN_STEPS, RERUN_STEP_FACTOR * (len(kept[0][1]) - 1)))
+            result = _follow_penalised(scene, elements, {**options, "core_level": choice.levels},
+                                       progress, max_steps=budget)
+            model, states, message, converged, limit_points, raised = result
             last = states[-1]
             if choice.how != "auto" or last.load_factor == 0.0:
+                break
+            if not converged and kept is not None:
+                # The raised path stopped short of the target: keep the pass it was checking.
+                choice.passes.append({"stage": f"path step {last.step}",
+                                      "elements_per_level": level_counts(choice.levels),
+                                      "load_factor": last.load_factor, "reached": False,
+                                      "estimate": None, "stopped": message})
+                stopped_rerun = message
+                (model, states, message, converged, limit_points, raised), choice.levels, \
+                    choice.estimate = kept
                 break
             if previous is not None:  # the change the last raise made is the estimate
                 choice.estimate = (abs(last.load_factor - previous.load_factor)
@@ -223,6 +243,7 @@ def run(
                     choice.estimate is not None and previous is not None
                     and choice.estimate <= tol):
                 break
+            kept = (result, choice.levels.copy(), choice.estimate)
             up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
                              **{**options, "core_level": lookahead_levels(choice.levels)})
             shares = state_shares(model, last.u, last.load_factor, up)
@@ -238,6 +259,9 @@ def run(
             previous = last
             if progress is not None:
                 progress(CoreRecheck(level_counts(choice.levels)))
+        if stopped_rerun:
+            message += (f"; WARNING: the rerun with raised core levels stopped ({stopped_rerun}); "
+                        "this is the pass it was checking")
         if choice.how == "auto" and not converged and np.any(choice.levels > 1):
             # The path at the chosen levels stopped short: the paper's element is the fallback
             # (extremes map: thin faces, L/h = 5 and load x2 reach their target only at level 1).
@@ -263,7 +287,7 @@ def run(
                     f"{100 * choice.estimate:.2g} % exceeds the tolerance "
                     f"{100 * float(bm.tolerance):.2g} %")
             message += (f"; WARNING: the core's estimated error {said} (max_core_level "
-                        f"{bm.max_core_level}, {CORE_RECHECKS} reruns)")
+                        f"{bm.max_core_level}, {len(choice.passes) - 1} rerun(s))")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(_growth_summary(scene, solution))
@@ -363,13 +387,16 @@ class CoreRecheck:
 
 def _follow_penalised(
     scene: object, elements: int | None, options: dict,
-    progress: Callable[[object], None] | None,
+    progress: Callable[[object], None] | None, max_steps: int | None = None,
 ) -> tuple[BeamModel, list[ConvergedState], str, bool, list[LimitPoint], list[float]]:
-    """Follow the path; rerun with a stiffer penalty while converged states penetrate too deep."""
+    """Follow the path; rerun with a stiffer penalty while converged states penetrate too deep.
+
+    ``max_steps`` (default the scene's) caps the steps of each attempt.
+    """
     raised: list[float] = []
     model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
     while True:
-        states, message, converged, limit_points = _follow(model, scene, progress)
+        states, message, converged, limit_points = _follow(model, scene, progress, max_steps)
         pen, bound = _max_penetration(model, states), model.penetration_bound()
         if pen <= bound or len(raised) == PENALTY_RESTARTS:
             return model, states, message, converged, limit_points, raised
@@ -380,14 +407,16 @@ def _follow_penalised(
 
 
 def _follow(
-    model: BeamModel, scene: object, progress: Callable[[object], None] | None
+    model: BeamModel, scene: object, progress: Callable[[object], None] | None,
+    max_steps: int | None = None,
 ) -> tuple[list[ConvergedState], str, bool, list[LimitPoint]]:
     """Follow the nonlinear path of ``scene`` on ``model``: states, message, reached, limits."""
     from sandwich.solver.path import PathOptions, follow_path
 
     a = scene.analysis
+    caps = {} if max_steps is None else {"max_steps": int(max_steps)}
     options = PathOptions.from_analysis(a, min_increment=_min_increment(model, a),
-                                        desired_iterations=DESIRED_ITERATIONS)
+                                        desired_iterations=DESIRED_ITERATIONS, **caps)
     result = follow_path(model, options, list(model.probe_rows), progress)
     states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
               for s in result.states]

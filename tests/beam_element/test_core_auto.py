@@ -8,6 +8,7 @@ and the scene's mirror symmetry.
 from __future__ import annotations
 
 import dataclasses
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ import pytest
 from beam_scenes import sandwich_scene
 
 from beam_element import run
+from beam_element.core_levels import level_counts
 from beam_element.model import build_model
 from beam_element.solve import linear_solution
 from sandwich.scene import Analysis, CoreZone
@@ -84,6 +86,30 @@ def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
     assert any(s.startswith("path step") for s in stages), stages
     assert r.solution.converged
     assert core["estimated_error"] <= 0.003 or "WARNING" in r.solution.message
+
+
+def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
+    """The rerun's step budget (a multiple of the checked pass's steps) cut to 2 steps: the
+    raised path cannot reach −6 mm, so the answer is the first path pass (its levels, its end
+    load)
+    with a WARNING, and the stopped rerun is listed in the passes."""
+    solve = sys.modules["beam_element.solve"]  # the module (the package exports a function)
+    monkeypatch.setattr(solve, "RERUN_STEP_FACTOR", 0)
+    monkeypatch.setattr(solve, "RERUN_MIN_STEPS", 2)
+    scene = sandwich_scene(elements=40, core_level="auto", analysis=Analysis(
+        kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
+        max_steps=200))
+    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, tolerance=0.003))
+    r = run(scene)
+    sol, core = r.solution, r.solution.extra["core"]
+    paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
+    first, rerun = paths[0], paths[-1]
+    assert sol.converged and "rerun with raised core levels stopped" in sol.message
+    assert rerun["reached"] is False and "max_steps = 2" in rerun["stopped"]
+    assert rerun["elements_per_level"] != first["elements_per_level"]
+    assert level_counts(r.model.element_levels) == first["elements_per_level"]
+    assert sol.final_load_factor == first["load_factor"]
 
 
 @pytest.mark.heavy
