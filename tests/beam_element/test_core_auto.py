@@ -91,8 +91,7 @@ def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
 def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
     """The rerun's step budget (a multiple of the checked pass's steps) cut to 2 steps: the
     raised path cannot reach −6 mm, so the answer is the first path pass (its levels, its end
-    load)
-    with a WARNING, and the stopped rerun is listed in the passes."""
+    load) with a WARNING, and the stopped rerun is listed in the passes."""
     solve = sys.modules["beam_element.solve"]  # the module (the package exports a function)
     monkeypatch.setattr(solve, "RERUN_STEP_FACTOR", 0)
     monkeypatch.setattr(solve, "RERUN_MIN_STEPS", 2)
