@@ -129,21 +129,29 @@ def linear_solution(model: BeamModel, load_factor: float) -> tuple[np.ndarray, i
     )
 
 
+def _toward_target(model: BeamModel, probe: str, target: float) -> tuple[float, np.ndarray, int]:
+    """The sign of λ whose linear solution moves ``probe`` towards ``target``.
+
+    Returns (sign, the linear solution at λ = sign, active-set passes). Unilateral contact
+    makes the response homogeneous for λ > 0 only, so both signs are solved if need be.
+    """
+    row = model.probe_vector(probe)
+    for sign in (1.0, -1.0):
+        u1, passes = linear_solution(model, sign)
+        if float(row @ u1) * target > 0:
+            return sign, u1, passes
+    raise ValueError(f"probe {probe!r} does not move under the scene's loads")
+
+
 def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState], str]:
     a = scene.analysis
     names = list(model.probe_rows)
     probe = {n: model.probe_vector(n) for n in names}
     zero = ConvergedState(0, 0.0, np.zeros(model.size), 0, {n: 0.0 for n in names})
     if a.until_probe is not None:
-        for sign in (1.0, -1.0):  # unilateral contact: the response is homogeneous for λ > 0
-            u1, passes = linear_solution(model, sign)
-            value = float(probe[a.until_probe] @ u1)
-            if value * a.until_value > 0:
-                λ = sign * a.until_value / value
-                u = u1 * (λ / sign)
-                break
-        else:
-            raise ValueError(f"probe {a.until_probe!r} does not move under the scene's loads")
+        sign, u1, passes = _toward_target(model, a.until_probe, a.until_value)
+        λ = sign * a.until_value / float(probe[a.until_probe] @ u1)
+        u = u1 * (λ / sign)
         message = f"linear solution scaled to {a.until_probe} = {a.until_value:g}"
     else:
         λ = a.until_load_factor if a.until_load_factor is not None else 1.0
@@ -362,9 +370,10 @@ def _load_sign(model: BeamModel, scene: object) -> float:
     """Sign of the load factor the analysis heads for (unilateral contact is not odd in λ)."""
     a = scene.analysis
     if a.until_probe is not None:
-        u, _ = linear_solution(model, 1.0)
-        value = float(model.probe_vector(a.until_probe) @ u)
-        return 1.0 if value * a.until_value >= 0 else -1.0
+        try:
+            return _toward_target(model, a.until_probe, a.until_value)[0]
+        except ValueError:  # the path follower says so in its own words
+            return 1.0
     if a.until_load_factor is not None and a.until_load_factor < 0:
         return -1.0
     return 1.0
