@@ -289,13 +289,14 @@ def run(
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
-        if choice.how == "auto" and converged and np.any(choice.levels > 1) and (
-                choice.estimate is None or choice.estimate > float(bm.tolerance)):
-            said = ("could not be estimated" if choice.estimate is None else
-                    f"{100 * choice.estimate:.2g} % exceeds the tolerance "
-                    f"{100 * float(bm.tolerance):.2g} %")
-            message += (f"; WARNING: the core's estimated error {said} (max_core_level "
-                        f"{bm.max_core_level}, {len(choice.passes) - 1} rerun(s))")
+    if choice.how == "auto" and converged and np.any(choice.levels > 1) and (
+            choice.estimate is None or choice.estimate > float(bm.tolerance)):
+        said = ("could not be estimated" if choice.estimate is None else
+                f"{100 * choice.estimate:.2g} % exceeds the tolerance "
+                f"{100 * float(bm.tolerance):.2g} %")
+        reruns = f", {_path_passes(choice) - 1} rerun(s) of the path" if nonlinear else ""
+        message += (f"; WARNING: the core's estimated error {said} (max_core_level "
+                    f"{bm.max_core_level}{reruns})")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(_growth_summary(scene, solution))
@@ -309,6 +310,11 @@ def run(
     }
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _path_passes(choice: LevelChoice) -> int:
+    """How many times auto followed the path (its passes after the linear-step ones)."""
+    return sum(p["stage"].startswith("path step") for p in choice.passes)
 
 
 def _growth_summary(scene: object, solution: Solution) -> dict[str, object]:
@@ -349,7 +355,7 @@ def choose_core_levels(scene: object, elements: int | None, options: dict) -> Le
     sign = _load_sign(build(floor), scene)
     choice = auto_levels(build, lambda m: linear_solution(m, sign)[0], mesh.n_elements,
                          float(getattr(bm, "tolerance", 0.01)),
-                         int(getattr(bm, "max_core_level", 4)), probe=scene.analysis.until_probe)
+                         int(getattr(bm, "max_core_level", 3)), probe=scene.analysis.until_probe)
     choice.levels = np.maximum(choice.levels, floor)
     return choice
 
