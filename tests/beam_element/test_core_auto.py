@@ -125,6 +125,26 @@ def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
     assert sol.final_load_factor == first["load_factor"]
 
 
+def test_no_rerun_is_read_as_convergence_once_the_zones_are_at_the_cap():
+    """Cap 2, with a core zone holding the load patch (± more than a core thickness) at 2: a
+    rerun could raise only elements away from the patch. auto does not rerun (that small change
+    would pass for convergence), keeps its estimate and says the zones are at the cap."""
+    scene = sandwich_scene(elements=40, core_level="auto", analysis=Analysis(
+        kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
+        max_steps=200))
+    load, h = scene.loads[0], scene.core.thickness
+    reach = load.width / 2 + h + 10.0
+    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, tolerance=0.02, max_core_level=2,
+        core_zones=(CoreZone(load.x - reach, load.x + reach, 2),)))
+    r = run(scene)
+    core = r.solution.extra["core"]
+    paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
+    assert np.any(r.model.element_levels < 2)  # a rerun was possible elsewhere
+    assert len(paths) == 1 and core["zones_at_max_level"] is True, core["passes"]
+    assert "at max_core_level 2: what a further raise there" in r.solution.message
+
+
 @pytest.mark.heavy
 @pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
 def test_shipped_scene_reaches_its_until_with_auto_levels(path):
