@@ -340,7 +340,10 @@ _NO_DATA = np.empty(0)
 
 
 SUM_FACTORISATION = "auto"  # "auto" (by flops, below), "always" (where the rows factor), "never"
-FACTORED_OVERHEAD = 1.5  # auto: factored when its flops × this < the packed kernel's
+# auto: factored when its flops × this < the packed kernel's. Measured (docs/beam_speed.md): at
+# the paper's core (2.2× fewer flops) the two take the same time, the factored kernel's smaller
+# GEMMs and gathers costing what its flops save; from level 2 on (5.6× and more) it is faster.
+FACTORED_OVERHEAD = 3.0
 
 
 def uses_sum_factorisation(op: LayerOperators) -> bool:
@@ -381,10 +384,11 @@ def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
     f = np.empty((u_l.shape[0], k.dofs.size))
     if uses_sum_factorisation(op):
         fo = factored_operators(op)
-        factored_kernel(u_l, lengths, float(width), fo.Xu, fo.Xdu, fo.Zu, fo.Zdu, fo.iu, fo.ju,
-                        fo.Xw, fo.Xdw, fo.Zw, fo.Zdw, fo.iw, fo.jw, fo.Quu, fo.Puu, fo.Euu,
-                        fo.Qww, fo.Pww, fo.Eww, fo.Quw, fo.Puw, fo.Euw, k.ucols, k.wcols, k.x_slope, k.weight, k.stiffness,
-                        k.thickness, f, want_k, K_out, slots, signs, data)
+        factored_kernel(u_l, lengths, float(width), fo.Xu, fo.Xdu, fo.ZuT, fo.ZduT, fo.iu,
+                        fo.ju, fo.Xw, fo.Xdw, fo.ZwT, fo.ZdwT, fo.iw, fo.jw, fo.Quu, fo.Puu,
+                        fo.Qww, fo.Pww, fo.Quw, fo.Puw, fo.entries, k.ucols, k.wcols,
+                        k.x_slope, k.weight, k.stiffness, k.thickness, f, want_k, K_out, slots,
+                        signs, data)
         return f
     _kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww, k.Quw, k.pu,
             k.pw, k.ucols, k.wcols, k.x_slope, k.weight, k.stiffness, k.thickness, f,

@@ -57,37 +57,36 @@ class FactoredOperators:
     """A layer's rows as x- and z-functions at a tensor rule (computed once per layer).
 
     Per field f (u, w): ``X``/``Xd`` (n_η, n_x) the x-functions and η-derivatives at the η
-    points, ``Z``/``Zd`` (n_ξ, n_z) the z-functions and ξ-derivatives at the ξ points, ``ix``,
+    points, ``ZT``/``ZdT`` (n_z, n_ξ) the z-functions and ξ-derivatives at the ξ points, ``ix``,
     ``jz`` (n_f,) the x- and z-function of each of the field's columns. Per field pair
     b (uu, ww, uw): ``Q`` (4, n_ξ, n_zp) the products A^t_j B^t_{j'} on the pair's z-pairs,
-    ``P`` (n_xp, 4 n_η) the products P^t_{ii'} (columns t slowest), ``E`` (entries, 4) the
-    layer columns (a, b), x-pair and z-pair of every entry of the pair's block that is not
-    identically zero (uu, ww: a ≤ b only, z-pairs j ≤ j').
+    ``P`` (n_xp, 4 n_η) the products P^t_{ii'} (columns t slowest, every ordered x-pair);
+    ``entries`` (3, n, n): block (0 uu, 1 ww, 2 uw, −1 identically zero), x-pair and z-pair of
+    each entry (a, b) of the layer's block (uu, ww: formed for z-pairs j ≤ j', the others
+    read as their mirror).
     """
 
     n_eta: int
     n_xi: int
     Xu: np.ndarray
     Xdu: np.ndarray
-    Zu: np.ndarray
-    Zdu: np.ndarray
+    ZuT: np.ndarray
+    ZduT: np.ndarray
     iu: np.ndarray
     ju: np.ndarray
     Xw: np.ndarray
     Xdw: np.ndarray
-    Zw: np.ndarray
-    Zdw: np.ndarray
+    ZwT: np.ndarray
+    ZdwT: np.ndarray
     iw: np.ndarray
     jw: np.ndarray
     Quu: np.ndarray
     Puu: np.ndarray
-    Euu: np.ndarray
     Qww: np.ndarray
     Pww: np.ndarray
-    Eww: np.ndarray
     Quw: np.ndarray
     Puw: np.ndarray
-    Euw: np.ndarray
+    entries: np.ndarray
 
 
 def _tensor_grid(op: LayerOperators) -> tuple[np.ndarray, np.ndarray] | None:
@@ -172,15 +171,33 @@ def _pair_block(Xa, Xda, Za, Zda, ia, ja, Xb, Xdb, Zb, Zdb, ib, jb, cols_a, cols
                                              indexing="ij"))
     P = np.ascontiguousarray(np.concatenate([A[:, xa] * B[:, xb] for A, B in xt]).T)
     xindex = np.arange(xa.size).reshape(Xa.shape[1], Xb.shape[1])
-    entries = []  # (a, b, x-pair, z-pair) of every entry not identically zero
+    xp = np.full((ia.size, ib.size), -1, dtype=np.int64)  # -1: identically zero
+    zp = np.full((ia.size, ib.size), -1, dtype=np.int64)
     for a in range(ia.size):
-        for b in range(a if symmetric else 0, ib.size):
+        for b in range(ib.size):
             i, ip, j, jp = ia[a], ib[b], ja[a], jb[b]
-            if symmetric and j > jp:  # K_ab = K_ba, formed for j ≤ j'
-                i, ip, j, jp = ip, i, jp, j
+            if symmetric and (j > jp or (j == jp and i > ip)):  # K_ab = K_ba, formed for
+                i, ip, j, jp = ip, i, jp, j  # j ≤ j' (i ≤ i' if j = j'): exactly symmetric
             if zindex[j, jp] >= 0:
-                entries.append((cols_a[a], cols_b[b], xindex[i, ip], zindex[j, jp]))
-    return Q, P, np.array(entries, dtype=np.int64).reshape(-1, 4)
+                xp[a, b], zp[a, b] = xindex[i, ip], zindex[j, jp]
+    return Q, P, xp, zp
+
+
+def _entry_map(n, cu, cw, uu, ww, uw):
+    """(block, x-pair, z-pair) of every entry (a, b) of the layer's n × n block.
+
+    Blocks 0 uu, 1 ww, 2 uw (a w, b u: the uw entry (b, a)), −1 identically zero.
+    """
+    m = np.full((3, n, n), -1, dtype=np.int64)
+    for block, (rows, cols, xp, zp) in enumerate(((cu, cu, uu[2], uu[3]), (cw, cw, ww[2], ww[3]),
+                                                   (cu, cw, uw[2], uw[3]))):
+        live = zp >= 0
+        r, c = np.meshgrid(rows, cols, indexing="ij")
+        for R, Cc in ((r, c), (c, r)) if block == 2 else ((r, c),):
+            m[0][R[live], Cc[live]] = block
+            m[1][R[live], Cc[live]] = xp[live]
+            m[2][R[live], Cc[live]] = zp[live]
+    return m
 
 
 def factored_operators(op: LayerOperators) -> FactoredOperators | None:
@@ -202,10 +219,11 @@ def factored_operators(op: LayerOperators) -> FactoredOperators | None:
             c = np.ascontiguousarray
             out = FactoredOperators(
                 n_eta=e1.size, n_xi=x1.size,
-                Xu=c(fu[0]), Xdu=c(fu[1]), Zu=c(fu[2]), Zdu=c(fu[3]), iu=fu[4], ju=fu[5],
-                Xw=c(fw[0]), Xdw=c(fw[1]), Zw=c(fw[2]), Zdw=c(fw[3]), iw=fw[4], jw=fw[5],
-                Quu=uu[0], Puu=uu[1], Euu=uu[2], Qww=ww[0], Pww=ww[1], Eww=ww[2],
-                Quw=uw[0], Puw=uw[1], Euw=uw[2])
+                Xu=c(fu[0]), Xdu=c(fu[1]), ZuT=c(fu[2].T), ZduT=c(fu[3].T), iu=fu[4], ju=fu[5],
+                Xw=c(fw[0]), Xdw=c(fw[1]), ZwT=c(fw[2].T), ZdwT=c(fw[3].T), iw=fw[4],
+                jw=fw[5],
+                Quu=uu[0], Puu=uu[1], Qww=ww[0], Pww=ww[1], Quw=uw[0], Puw=uw[1],
+                entries=_entry_map(op.dofs.size, cu, cw, uu, ww, uw))
     object.__setattr__(op, "_factored_operators", out)
     return out
 
@@ -220,8 +238,8 @@ def factored_flops(fo: FactoredOperators, tangent: bool = True) -> int:
     """
     G = fo.n_eta * fo.n_xi
     f = 0
-    for X, Z in ((fo.Xu, fo.Zu), (fo.Xw, fo.Zw)):
-        nx, nz = X.shape[1], Z.shape[1]
+    for X, Z in ((fo.Xu, fo.ZuT), (fo.Xw, fo.ZwT)):
+        nx, nz = X.shape[1], Z.shape[0]
         f += 2 * 2 * 2 * (nx * nz * fo.n_xi + G * nx)  # gradients and force, 2 derivatives
     if not tangent:
         return f
@@ -231,22 +249,65 @@ def factored_flops(fo: FactoredOperators, tangent: bool = True) -> int:
     return f
 
 
-@njit
-def factored_kernel(u_l, lengths, width, Xu, Xdu, Zu, Zdu, iu, ju, Xw, Xdw, Zw, Zdw, iw, jw,
-                    Quu, Puu, Euu, Qww, Pww, Eww, Quw, Puw, Euw, ucols, wcols, x_slope, weight, C, thickness, f_out, want_k, K_out, slots,
-                    signs, data):  # pragma: no cover - compiled
+@njit(reassociate=True)
+def _z_contract(Ut, ZT, V):  # pragma: no cover - compiled
+    """V[r, q] = Σ_j Ũ[r, j] Z_j(ξ_q) (ZT: (n_z, n_ξ))."""
+    V[:] = 0.0
+    for r in range(Ut.shape[0]):
+        for j in range(Ut.shape[1]):
+            c = Ut[r, j]
+            if c != 0.0:
+                for q in range(ZT.shape[1]):
+                    V[r, q] += c * ZT[j, q]
+
+
+@njit(reassociate=True)
+def _x_contract(X, V, D):  # pragma: no cover - compiled
+    """D[p, q] = Σ_r X_r(η_p) V[r, q]."""
+    D[:] = 0.0
+    for p in range(X.shape[0]):
+        for r in range(X.shape[1]):
+            c = X[p, r]
+            for q in range(V.shape[1]):
+                D[p, q] += c * V[r, q]
+
+
+@njit(reassociate=True)
+def _x_integrate(X, Cq, A):  # pragma: no cover - compiled
+    """A[r, q] = Σ_p X_r(η_p) c[p, q]."""
+    A[:] = 0.0
+    for p in range(X.shape[0]):
+        for r in range(X.shape[1]):
+            c = X[p, r]
+            for q in range(Cq.shape[1]):
+                A[r, q] += c * Cq[p, q]
+
+
+@njit(reassociate=True)
+def _z_integrate(A0, A1, ZT, ZdT, ix, jz, cols, scale, f):  # pragma: no cover - compiled
+    """f[cols[a]] = scale · Σ_q (A0[i, q] Z_j(ξ_q) + A1[i, q] Z'_j(ξ_q)), (i, j) of column a."""
+    for a in range(ix.size):
+        r = ix[a]
+        j = jz[a]
+        s = 0.0
+        for q in range(ZT.shape[1]):
+            s += A0[r, q] * ZT[j, q] + A1[r, q] * ZdT[j, q]
+        f[cols[a]] = s * scale[cols[a]]
+
+
+@njit(reassociate=True)
+def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, ZwT, ZdwT, iw, jw,
+                    Quu, Puu, Qww, Pww, Quw, Puw, entries, ucols, wcols, x_slope, weight, C,
+                    thickness, f_out, want_k, K_out, slots, signs,
+                    data):  # pragma: no cover - compiled
     """Force into ``f_out`` (E, n); tangent into ``K_out`` (E, n, n) or ``data[slots]``.
 
     The same arguments and outputs as :func:`beam_element.kernels._kernel`, with the rows given
-    by their factors (:class:`FactoredOperators`).
+    by their factors (:class:`FactoredOperators`; z-functions transposed, (n_z, n_ξ)).
     """
     E = u_l.shape[0]
     Gx = Xu.shape[0]
-    Gz = Zu.shape[0]
-    nxu = Xu.shape[1]
-    nzu = Zu.shape[1]
-    nxw = Xw.shape[1]
-    nzw = Zw.shape[1]
+    Gz = ZuT.shape[1]
     nu = ucols.size
     nw = wcols.size
     n = x_slope.size
@@ -256,31 +317,38 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, Zu, Zdu, iu, ju, Xw, Xdw, Zw, 
     c00, c01, c02 = C[0, 0], C[0, 1], C[0, 2]
     c10, c11, c12 = C[1, 0], C[1, 1], C[1, 2]
     c20, c21, c22 = C[2, 0], C[2, 1], C[2, 2]
-    nzp_uu = Quu.shape[2]
-    nzp_ww = Qww.shape[2]
-    nzp_uw = Quw.shape[2]
-    # work arrays, one element at a time (gradients, force) and one block (the tangent)
-    Ut = np.empty((nxu, nzu))
-    Wt = np.empty((nxw, nzw))
-    Vu0 = np.empty((nxu, Gz))
-    Vu1 = np.empty((nxu, Gz))
-    Vw0 = np.empty((nxw, Gz))
-    Vw1 = np.empty((nxw, Gz))
+    nzp = (Quu.shape[2], Qww.shape[2], Quw.shape[2])
+    nxp = (Puu.shape[0], Pww.shape[0], Puw.shape[0])
+    # work arrays: one element (gradients, force), one block (the tangent)
+    Ut = np.empty((Xu.shape[1], ZuT.shape[0]))
+    Wt = np.empty((Xw.shape[1], ZwT.shape[0]))
+    Vu0 = np.empty((Xu.shape[1], Gz))
+    Vu1 = np.empty((Xu.shape[1], Gz))
+    Vw0 = np.empty((Xw.shape[1], Gz))
+    Vw1 = np.empty((Xw.shape[1], Gz))
+    Du0 = np.empty((Gx, Gz))
+    Du1 = np.empty((Gx, Gz))
+    Dw0 = np.empty((Gx, Gz))
+    Dw1 = np.empty((Gx, Gz))
     Cu0 = np.empty((Gx, Gz))
     Cu1 = np.empty((Gx, Gz))
     Cw0 = np.empty((Gx, Gz))
     Cw1 = np.empty((Gx, Gz))
-    Au0 = np.empty((nxu, Gz))
-    Au1 = np.empty((nxu, Gz))
-    Aw0 = np.empty((nxw, Gz))
-    Aw1 = np.empty((nxw, Gz))
+    Au0 = np.empty((Xu.shape[1], Gz))
+    Au1 = np.empty((Xu.shape[1], Gz))
+    Aw0 = np.empty((Xw.shape[1], Gz))
+    Aw1 = np.empty((Xw.shape[1], Gz))
     scale = np.empty(n)
-    Ke = np.zeros((n, n))  # entries identically zero stay zero
     ch = min(CHUNK, E) if want_k else 1
-    Hb = np.empty((10, Gx * ch, Gz))  # H00 H11 H01 | H22 H33 H23 | H02 H03 H12 H13, (p, e, q)
-    Suu = np.empty((4, Gx * ch, nzp_uu))
-    Sww = np.empty((4, Gx * ch, nzp_ww))
-    Suw = np.empty((4, Gx * ch, nzp_uw))
+    Hb = np.zeros((10, Gx * ch, Gz))  # H00 H11 H01 | H22 H33 H23 | H02 H03 H12 H13, (p, e, q)
+    Suu = np.empty((4, Gx * ch, nzp[0]))
+    Sww = np.empty((4, Gx * ch, nzp[1]))
+    Suw = np.empty((4, Gx * ch, nzp[2]))
+    total = nxp[0] * ch * nzp[0] + nxp[1] * ch * nzp[1] + nxp[2] * ch * nzp[2]
+    Kall = np.zeros(total + 1)  # the three pair blocks of a block of elements, then a zero
+    src = np.empty((n, n), dtype=np.int64)  # entry (a, b) of element i: Kall[src + i step]
+    step = np.empty((n, n), dtype=np.int64)
+    src_ec = -1
     huu = (0, 1, 2, 2)
     hww = (3, 4, 5, 5)
     huw = (6, 7, 8, 9)
@@ -298,42 +366,23 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, Zu, Zdu, iu, ju, Xw, Xdw, Zw, 
             for a in range(nw):
                 Wt[iw[a], jw[a]] = u_l[e, wcols[a]] * scale[wcols[a]]
             # ξ first: V[i, q] = Σ_j Ũ[i, j] Z_j(ξ_q), then η: D[p, q] = Σ_i X_i(η_p) V[i, q]
-            for r in range(nxu):
-                for q in range(Gz):
-                    s0 = 0.0
-                    s1 = 0.0
-                    for j in range(nzu):
-                        s0 += Ut[r, j] * Zu[q, j]
-                        s1 += Ut[r, j] * Zdu[q, j]
-                    Vu0[r, q] = s0
-                    Vu1[r, q] = s1
-            for r in range(nxw):
-                for q in range(Gz):
-                    s0 = 0.0
-                    s1 = 0.0
-                    for j in range(nzw):
-                        s0 += Wt[r, j] * Zw[q, j]
-                        s1 += Wt[r, j] * Zdw[q, j]
-                    Vw0[r, q] = s0
-                    Vw1[r, q] = s1
+            _z_contract(Ut, ZuT, Vu0)
+            _z_contract(Ut, ZduT, Vu1)
+            _z_contract(Wt, ZwT, Vw0)
+            _z_contract(Wt, ZdwT, Vw1)
+            _x_contract(Xdu, Vu0, Du0)  # N,η u
+            _x_contract(Xu, Vu1, Du1)  # N,ξ u
+            _x_contract(Xdw, Vw0, Dw0)
+            _x_contract(Xw, Vw1, Dw1)
             dx = 2.0 / lengths[e]
             dV0 = width * (0.5 * lengths[e]) * (0.5 * thickness)  # b l h / 4, eq. (19)
             for p in range(Gx):
+                row = p * ec + i  # rows of the block's point matrices: (p, e)
                 for q in range(Gz):
-                    du0 = 0.0
-                    du1 = 0.0
-                    for r in range(nxu):
-                        du0 += Xdu[p, r] * Vu0[r, q]
-                        du1 += Xu[p, r] * Vu1[r, q]
-                    dw0 = 0.0
-                    dw1 = 0.0
-                    for r in range(nxw):
-                        dw0 += Xdw[p, r] * Vw0[r, q]
-                        dw1 += Xw[p, r] * Vw1[r, q]
-                    ux = dx * du0  # eq. (15)
-                    uz = dz * du1
-                    wx = dx * dw0
-                    wz = dz * dw1
+                    ux = dx * Du0[p, q]  # eq. (15)
+                    uz = dz * Du1[p, q]
+                    wx = dx * Dw0[p, q]
+                    wz = dz * Dw1[p, q]
                     ex = ux + 0.5 * (ux * ux + wx * wx)  # Green-Lagrange, eq. (15)
                     ez = wz + 0.5 * (uz * uz + wz * wz)
                     gm = uz + wx + ux * uz + wx * wz
@@ -370,7 +419,7 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, Zu, Zdu, iu, ju, Xw, Xdw, Zw, 
                     sx = sa * dx * dx  # eq. (25)
                     sz = sb * dz * dz
                     sxz = st * dx * dz
-                    row = p * ec + i  # H = dV Φᵀ C Φ (eq. 24) + the stress terms (eq. 25)
+                    # H = dV Φᵀ C Φ (eq. 24) + the stress terms (eq. 25)
                     Hb[0, row, q] = dV * (p00 * a00 + p20 * a20) + sx  # H00
                     Hb[1, row, q] = dV * (p11 * a11 + p21 * a21) + sz  # H11
                     Hb[2, row, q] = dV * (p00 * a01 + p20 * a21) + sxz  # H01
@@ -381,73 +430,54 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, Zu, Zdu, iu, ju, Xw, Xdw, Zw, 
                     Hb[7, row, q] = dV * (p00 * a03 + p20 * a23)  # H03
                     Hb[8, row, q] = dV * (p11 * a12 + p21 * a22)  # H12
                     Hb[9, row, q] = dV * (p11 * a13 + p21 * a23)  # H13
-            # force: A[i, q] = Σ_p X_i(η_p) c(p, q), then F[i, j] = Σ_q A[i, q] Z_j(ξ_q)
-            for r in range(nxu):
-                for q in range(Gz):
-                    s0 = 0.0
-                    s1 = 0.0
-                    for p in range(Gx):
-                        s0 += Xdu[p, r] * Cu0[p, q]
-                        s1 += Xu[p, r] * Cu1[p, q]
-                    Au0[r, q] = s0
-                    Au1[r, q] = s1
-            for r in range(nxw):
-                for q in range(Gz):
-                    s0 = 0.0
-                    s1 = 0.0
-                    for p in range(Gx):
-                        s0 += Xdw[p, r] * Cw0[p, q]
-                        s1 += Xw[p, r] * Cw1[p, q]
-                    Aw0[r, q] = s0
-                    Aw1[r, q] = s1
-            for a in range(nu):
-                r = iu[a]
-                j = ju[a]
-                s = 0.0
-                for q in range(Gz):
-                    s += Au0[r, q] * Zu[q, j] + Au1[r, q] * Zdu[q, j]
-                f_out[e, ucols[a]] = s * scale[ucols[a]]
-            for a in range(nw):
-                r = iw[a]
-                j = jw[a]
-                s = 0.0
-                for q in range(Gz):
-                    s += Aw0[r, q] * Zw[q, j] + Aw1[r, q] * Zdw[q, j]
-                f_out[e, wcols[a]] = s * scale[wcols[a]]
+            # force: A[i, q] = Σ_p X_i(η_p) c(p, q), then f_(i j) = Σ_q A[i, q] Z_j(ξ_q)
+            _x_integrate(Xdu, Cu0, Au0)
+            _x_integrate(Xu, Cu1, Au1)
+            _x_integrate(Xdw, Cw0, Aw0)
+            _x_integrate(Xw, Cw1, Aw1)
+            _z_integrate(Au0, Au1, ZuT, ZduT, iu, ju, ucols, scale, f_out[e])
+            _z_integrate(Aw0, Aw1, ZwT, ZdwT, iw, jw, wcols, scale, f_out[e])
         if not want_k:
             continue
         m = Gx * ec
-        # stage 1 (ξ): S_t[(p, e), zpair] = Σ_q H_t[(p, e), q] Q_t[q, zpair]
+        # stage 1 (ξ): S_t[(p, e), z-pair] = Σ_q H_t[(p, e), q] Q_t[q, z-pair]
         for t in range(4):
             np.dot(Hb[huu[t], :m], Quu[t], Suu[t, :m])
             np.dot(Hb[hww[t], :m], Qww[t], Sww[t, :m])
             np.dot(Hb[huw[t], :m], Quw[t], Suw[t, :m])
-        # stage 2 (η): K[xpair, (e, zpair)] = Σ_(t, p) P[xpair, (t, p)] S[(t, p), (e, zpair)]
-        if ec == ch:
-            Kuu = np.dot(Puu, Suu.reshape(4 * Gx, ec * nzp_uu))
-            Kww = np.dot(Pww, Sww.reshape(4 * Gx, ec * nzp_ww))
-            Kuw = np.dot(Puw, Suw.reshape(4 * Gx, ec * nzp_uw))
-        else:  # the last, partial block: its rows are the first m of each S_t
-            Kuu = np.dot(Puu, np.ascontiguousarray(Suu[:, :m]).reshape(4 * Gx, ec * nzp_uu))
-            Kww = np.dot(Pww, np.ascontiguousarray(Sww[:, :m]).reshape(4 * Gx, ec * nzp_ww))
-            Kuw = np.dot(Puw, np.ascontiguousarray(Suw[:, :m]).reshape(4 * Gx, ec * nzp_uw))
+        # stage 2 (η): K[x-pair, (e, z-pair)] = Σ_(t, p) P[x-pair, (t, p)] S[(t, p), (e, z-pair)]
+        o1 = nxp[0] * ec * nzp[0]
+        o2 = o1 + nxp[1] * ec * nzp[1]
+        o3 = o2 + nxp[2] * ec * nzp[2]
+        for S, P, lo, hi, w in ((Suu, Puu, 0, o1, nzp[0]), (Sww, Pww, o1, o2, nzp[1]),
+                                (Suw, Puw, o2, o3, nzp[2])):
+            St = S.reshape(4 * Gx, ec * w) if ec == ch else \
+                np.ascontiguousarray(S[:, :m]).reshape(4 * Gx, ec * w)
+            np.dot(P, St, Kall[lo:hi].reshape(P.shape[0], ec * w))
+        if src_ec != ec:  # where each entry (a, b) of element i sits in Kall
+            src_ec = ec
+            offsets = (0, o1, o2)
+            for a in range(n):
+                for b in range(n):
+                    blk = entries[0, a, b]
+                    if blk < 0:
+                        src[a, b] = total  # the zero
+                        step[a, b] = 0
+                    else:
+                        src[a, b] = offsets[blk] + entries[1, a, b] * ec * nzp[blk] + \
+                            entries[2, a, b]
+                        step[a, b] = nzp[blk]
         for i in range(ec):
             e = e0 + i
             half = 0.5 * lengths[e]
             for a in range(n):
                 scale[a] = half if x_slope[a] else 1.0
-            for K, En, nzp in ((Kuu, Euu, nzp_uu), (Kww, Eww, nzp_ww), (Kuw, Euw, nzp_uw)):
-                for t in range(En.shape[0]):
-                    ia = En[t, 0]
-                    ib = En[t, 1]
-                    v = K[En[t, 2], i * nzp + En[t, 3]] * scale[ia] * scale[ib]
-                    Ke[ia, ib] = v
-                    Ke[ib, ia] = v
-            if blocks:
-                K_out[e] = Ke
-            if scatter:  # row by row: slots and data in memory order
-                for a in range(n):
-                    for b in range(n):
+            for a in range(n):  # row by row: slots and data in memory order
+                for b in range(n):
+                    v = Kall[src[a, b] + i * step[a, b]] * (scale[a] * scale[b])
+                    if blocks:
+                        K_out[e, a, b] = v
+                    if scatter:
                         s = slots[e, a, b]
                         if s >= 0:
-                            data[s] += signs[e, a, b] * Ke[a, b]
+                            data[s] += signs[e, a, b] * v
