@@ -49,7 +49,7 @@ from sandwich.solver.jit import njit
 __all__ = ["FactoredOperators", "factored_flops", "factored_operators"]
 
 FACTOR_TOLERANCE = 1e-13  # relative: rows reproduced by the products to round-off
-CHUNK = 32  # elements per block: the block's stage-1 outputs (≈ 4 n_η n_z² × 3 per element) in L2
+CHUNK = 16  # elements per block (measured: 8-16 best at levels 2-4; 32 +5 %, 64 +25 %)
 
 
 @dataclass(frozen=True)

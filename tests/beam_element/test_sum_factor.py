@@ -21,7 +21,7 @@ from beam_element.core_basis import CoreBasis
 from beam_element.layer_operators import build_core_operators, build_layer_operators
 from beam_element.model import build_model
 from beam_element.quadrature import EXACT_ORDER
-from beam_element.sum_factor import factored_operators
+from beam_element.sum_factor import CHUNK, factored_operators
 
 TOL = 1e-12  # relative to the largest entry: round-off of sums over ≤ 343 points
 
@@ -54,8 +54,9 @@ def test_factored_kernel_matches_packed_kernel_and_numpy(basis, level, mode):
     op = _core(basis, level)
     assert factored_operators(op) is not None
     rng = np.random.default_rng(level)
-    E = 70  # two full blocks of 32 elements and a partial one
+    E = 70  # several blocks of sum_factor.CHUNK elements, the last one partial
     u, lengths = _state(op, rng, E, 0.4)  # displacement gradients of order 0.1-0.5
+    assert E > 2 * CHUNK and E % CHUNK
     f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
     mode("never")
     f_packed, K_packed = kernels.layer_response(op, u, lengths, 60.0)
