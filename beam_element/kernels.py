@@ -23,6 +23,11 @@ The tangent is either written as blocks ``(E, n, n)`` (:func:`layer_response`, t
 matrix through a precomputed slot map (:func:`layer_assemble`, used by the model), which skips
 the blocks and their concatenation. Layers with the ``membrane_average`` option use the NumPy
 path.
+
+Layers whose rows factor into x- and z-functions at a tensor rule are evaluated instead by the
+sum-factorised kernel of :mod:`beam_element.sum_factor` (same integrand, same points, ξ summed
+first) where that saves enough flops (:func:`uses_sum_factorisation`): the enriched cores
+(levels ≥ 2). The paper's layers keep the packed kernel below.
 """
 
 from __future__ import annotations
