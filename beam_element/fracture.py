@@ -26,12 +26,16 @@ by the penalty contact, a closed crack) is reported as 0. All in N/mm (= kJ/m²)
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from beam_element.dofs import TIES, global_dof
-from beam_element.model import BeamModel
 from sandwich.results.fracture import TipRelease, column_names, history_columns  # noqa: F401
+
+# A beam_element.model.BeamModel: not imported, the model imports this module (it holds its
+# tips and gives their G to every accepted path state).
+BeamModel = Any
 
 TIE_ROLES = ("u", "w", "w,x")  # order of the pairs in dofs.TIES
 # Core levels (beam_element.core_levels) that change within this many elements of a tip bias G:
@@ -123,3 +127,78 @@ def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip]) -> list[T
     return out
 
 
+
+
+def release_columns(model: BeamModel, u: np.ndarray, tips: list[BeamTip]
+                    ) -> dict[str, float | None]:
+    """The history columns of :func:`tip_releases`; ``None`` (an empty cell) where not finite.
+
+    Never raises for a state the path accepted: a tip whose G cannot be evaluated gets empty
+    cells (the writer leaves them blank, ``summary.json`` ``G_warning`` says so) instead of a
+    NaN or a lost history.
+    """
+    if not tips:
+        return {}
+    try:
+        cols: dict[str, float | None] = dict(history_columns(tip_releases(model, u, tips)))
+    except (ValueError, FloatingPointError, np.linalg.LinAlgError):
+        cols = {}
+    for t in tips:
+        for name in column_names(t.debond, t.tip):
+            v = cols.get(name)
+            cols[name] = v if v is not None and np.isfinite(v) else None
+    return cols
+
+
+def _frame(model: BeamModel, u_full: np.ndarray, t: BeamTip) -> tuple[float, float]:
+    """(cos φ, sin φ) of the core boundary at the tip, φ = atan(w_c,x / (1 + u_c,x))."""
+    core, _ = tie_dofs(t.interface, t.node)
+    u_x = u_full[global_dof(t.node, TIES[t.interface][0][0] + ",x")]
+    φ = np.arctan2(u_full[core[2]], 1.0 + u_x)
+    return float(np.cos(φ)), float(np.sin(φ))
+
+
+def closure_release(model: BeamModel, u: np.ndarray, t: BeamTip, elements: int) -> TipRelease:
+    """G over a closure length of ``elements`` tip elements (a diagnostic of the VCCT estimate).
+
+    Δ = the distance from the tip node to the ``elements``-th untied node behind it. The tie
+    reactions R_k of the bonded nodes ahead of the tip at s_k < Δ (tip node included) close the
+    jumps δ found at the mirrored distance Δ − s_k behind (linear interpolation between the
+    untied nodes): G = Σ_k R_k · δ(Δ − s_k) / (2 b Δ), the discrete closure integral
+    ∫₀^Δ t(s) δ(Δ − s) ds / (2Δ) with the ties' force representation, as in 2D
+    (reference2d/fracture.py). ``elements = 1`` is :func:`tip_releases`.
+    """
+    u_full = model.expand(u)
+    f_full = model.full_response(u_full, tangent=False)[0]
+    x = model.mesh.x
+    back = int(np.sign(t.behind - t.node))
+    n_nodes = len(x)
+    behind_nodes = [t.node + back * k for k in range(0, elements + 1)
+                    if 0 <= t.node + back * k < n_nodes]
+    if len(behind_nodes) < 2:
+        return TipRelease(t.debond, t.tip, 0.0, 0.0, 0.0, 0.0)
+    delta = float(abs(x[behind_nodes[-1]] - x[t.node]))
+    # jumps at the nodes behind (distance r from the tip); r = 0 at the tip itself (tied: 0)
+    r_b = np.abs(x[behind_nodes] - x[t.node])
+    jumps = np.array([u_full[tie_dofs(t.interface, k)[1]] - u_full[tie_dofs(t.interface, k)[0]]
+                      for k in behind_nodes])
+    jumps[0] = 0.0
+    c, s = _frame(model, u_full, t)
+    work_n = work_t = 0.0
+    k = t.node
+    while 0 <= k < n_nodes:
+        s_k = abs(x[k] - x[t.node])
+        if s_k >= delta * (1.0 - 1e-9):
+            break
+        core, _ = tie_dofs(t.interface, k)
+        R = f_full[core]
+        d = np.array([np.interp(delta - s_k, r_b, jumps[:, j]) for j in range(3)])
+        R_t, R_n = c * R[0] + s * R[1], -s * R[0] + c * R[1]
+        d_t, d_n = c * d[0] + s * d[1], -s * d[0] + c * d[1]
+        work_n += R_n * d_n + R[2] * d[2]
+        work_t += R_t * d_t
+        k -= back
+    scale = 1.0 / (2.0 * model.width * delta)
+    gi = max(scale * work_n, 0.0)
+    gii = scale * work_t
+    return TipRelease(t.debond, t.tip, gi + gii, gi, gii, delta)
