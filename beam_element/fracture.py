@@ -2,25 +2,40 @@
 
 At a bonded node the core's boundary DOFs follow the face's (section 2.3, imposed by
 elimination): u_c = u_f, w_c = w_f, w_c,x = w_f,x (top: u_ct = u_tb, w_ct = w_t, w_ct,x = w_t,x;
-bottom: u_cb = u_bt, w_cb = w_b, w_cb,x = w_b,x). Untying the tip node extends the debond by
-one element, Δ = the length of the element behind the tip (the mesh fills a debond and its tips
-with its smallest elements, so the element ahead has the same length). The virtual crack
-closure estimate of the energy released, per unit crack area, is
+bottom: u_cb = u_bt, w_cb = w_b, w_cb,x = w_b,x). The tie reaction R_k at a bonded node k is
+the force (N) or moment (N·mm) that the face exerts on the core's tied DOF j ∈ {u, w, w,x},
+i.e. the core layer's internal force on that DOF (eq. 19, the core elements on both sides of
+the node; the tie itself carries no stiffness of its own); the jump δ = face DOF − core DOF
+of a tie pair at an untied node is the sliding, the opening (mm) and the rotation jump (rad).
 
-    G = 1/(2 b Δ) Σ_j R_j δ_j,   j ∈ {u, w, w,x}
+The virtual crack closure estimate of G, per unit crack area, over a closure length Δ of
+n tip elements (the mesh fills a debond with its smallest elements):
 
-with R_j the tie reaction at the tip node, the force (N) or moment (N·mm) that the face exerts on
-the core's tied DOF j, i.e. the core layer's internal force on that DOF (eq. 19, the core
-elements on both sides of the node; the tie itself carries no stiffness of its own), and
-δ_j = face DOF − core DOF of the tie pair at the first untied node behind the tip: the opening
-(mm), sliding (mm) and the rotation jump (rad) that node shows now.
+    G = 1/(2 b Δ) Σ_k R_k · δ(Δ − s_k)
 
-Mode split (the beam-theory, "global" partition): G_II from the tangential force × sliding,
-G_I from the normal force × opening plus the interface moment × the rotation jump (the moment is
-a couple of normal interface tractions). Forces and displacements are resolved on the core
+over the bonded nodes at the distance s_k < Δ ahead of the tip (the tip node included), δ
+interpolated linearly at the mirrored distance Δ − s_k behind it: the closure integral
+∫₀^Δ t(s) δ(Δ − s) ds / (2Δ) with the ties' force representation, as in 2D. The history
+columns use n = ``CLOSURE_ELEMENTS`` = 1 (R at the tip node × δ at the first node behind,
+Δ = that element). Measured (``benchmarks/results/fracture/core_levels.md``, docs/fracture.md):
+on the closed-form cases one element is +0.6 % (core level 1) to +2.7 % (level 4) high and
+does not converge with the mesh at levels > 1 (a richer core concentrates the tie forces at the
+tip node), while 8 elements are within 0.3 % for levels 1-4 and 240-960 elements, the split
+included; but once a debonded face has buckled and peels at a large rotation (fig. 5 past
+the buckling) G falls with Δ (−7 % at 4 elements, −18 % at 8: the opening behind the tip is
+no longer self-similar over Δ), where one element stays consistent with the 2D J-integral
+trend. So the default stays one element; :func:`closure_release` gives the others.
+
+Mode split (the beam-theory, "global" partition): G_II from the tangential forces × sliding,
+G_I from the normal forces × opening plus the interface moments × the rotation jumps (a moment
+is a couple of normal interface tractions). Forces and displacements are resolved on the core
 boundary at the tip, rotated by atan(w_c,x / (1 + u_c,x)) (eq. 15 kinematics), so the split
 stays meaningful when the section rotates. A negative G_I (the lips pressed into each other
 by the penalty contact, a closed crack) is reported as 0. All in N/mm (= kJ/m²).
+
+A core level that changes near a tip biases G whatever the estimate (the discrete model's
+own energy release changes: the level patch is a local inhomogeneity at the tip); the summary
+warns (:func:`level_warning`).
 """
 
 from __future__ import annotations
@@ -38,11 +53,14 @@ from sandwich.results.fracture import TipRelease, column_names, history_columns 
 BeamModel = Any
 
 TIE_ROLES = ("u", "w", "w,x")  # order of the pairs in dofs.TIES
-# Core levels (beam_element.core_levels) that change within this many elements of a tip bias G:
-# measured on the sliding couples, an "auto" level-2 patch of 5 elements around the tip gave
-# G +4.6 % and the cantilever slope d√G/da −10 %, while uniform levels 1-4 stay within 2.4 %
-# (docs/fracture.md).
+CLOSURE_ELEMENTS = 1  # tip elements of closure of the history columns (see above)
+# A core level (beam_element.core_levels) that changes near a tip biases G (measured on the
+# closed-form cases, core 10 mm, 8-element closure; benchmarks/results/fracture/core_levels.md):
+# a level patch of 5 elements each side of the tip (transitions 0.4-0.8 mm behind it) −3 …
+# −22 %; transitions 1.2 mm behind / 7.5 mm ahead +1.5/+2.5 %, 2.5 / 15 mm ≤ 1.2 %, 5 / 31 mm
+# ≤ 0.3 %. Warned within the larger of this many elements and LEVEL_ZONE core thicknesses.
 LEVEL_NEIGHBOURHOOD = 8
+LEVEL_ZONE = 0.5
 
 
 @dataclass(frozen=True)
@@ -78,21 +96,32 @@ def beam_tips(scene: object, model: BeamModel) -> list[BeamTip]:
 
 
 def level_warning(model: BeamModel, tips: list[BeamTip]) -> str:
-    """A warning naming the tips whose neighbourhood has mixed core levels, or ``""``."""
+    """A warning naming the tips whose neighbourhood has mixed core levels, or ``""``.
+
+    The neighbourhood: :data:`LEVEL_NEIGHBOURHOOD` elements, or :data:`LEVEL_ZONE` core
+    thicknesses if longer, on each side of the tip.
+    """
     levels = getattr(model, "element_levels", None)
     if levels is None:
         return ""
+    x = model.mesh.x
+    centres = 0.5 * (x[:-1] + x[1:])
+    reach = LEVEL_ZONE * float(model.layers["core"].thickness)
     bad = []
     for t in tips:
         lo = max(min(t.node, t.behind) - LEVEL_NEIGHBOURHOOD, 0)
         hi = min(max(t.node, t.behind) + LEVEL_NEIGHBOURHOOD, len(levels))
-        if len(np.unique(levels[lo:hi])) > 1:
+        near = np.zeros(len(levels), dtype=bool)
+        near[lo:hi] = True
+        near |= np.abs(centres - x[t.node]) < reach
+        if len(np.unique(levels[near])) > 1:
             bad.append(f"{t.debond}_{t.tip}")
     if not bad:
         return ""
-    return (f"the core level changes within {LEVEL_NEIGHBOURHOOD} elements of debond "
-            f"tip(s) {', '.join(bad)}: G there is biased by up to ~10 % (set a uniform "
-            "[beam_model] core level or a core_zones entry over the tip; docs/fracture.md)")
+    return (f"the core level changes within {LEVEL_ZONE:g} core thickness (or "
+            f"{LEVEL_NEIGHBOURHOOD} elements) of debond tip(s) {', '.join(bad)}: G there is "
+            "biased, by up to tens of per cent for a short patch (set a uniform [beam_model] "
+            "core level or a core_zones entry over the tip; docs/fracture.md)")
 
 
 def tie_dofs(interface: str, node: int | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -102,31 +131,18 @@ def tie_dofs(interface: str, node: int | np.ndarray) -> tuple[np.ndarray, np.nda
     return core, face
 
 
-def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip]) -> list[TipRelease]:
-    """G, G_I, G_II at ``tips`` for the free DOF vector ``u``."""
+def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip],
+                 elements: int = CLOSURE_ELEMENTS) -> list[TipRelease]:
+    """G, G_I, G_II at ``tips`` for the free DOF vector ``u``: :func:`closure_release`.
+
+    ``elements`` tip elements of closure (default :data:`CLOSURE_ELEMENTS` = 1: the tip node's
+    reaction × the jumps at the first node behind; fewer if the debond has fewer).
+    """
     if not tips:
         return []
     u_full = model.expand(u)
     f_full = model.full_response(u_full, tangent=False)[0]
-    out = []
-    for t in tips:
-        core, face = tie_dofs(t.interface, t.node)
-        R = f_full[core]  # (R_u, R_w, R_θ): face on core at the tip, N and N·mm
-        core_b, face_b = tie_dofs(t.interface, t.behind)
-        δ = u_full[face_b] - u_full[core_b]  # sliding, opening (mm), rotation jump (rad)
-        u_x = u_full[global_dof(t.node, TIES[t.interface][0][0] + ",x")]
-        w_x = u_full[core[2]]
-        φ = np.arctan2(w_x, 1.0 + u_x)  # rotation of the core boundary at the tip
-        c, s = np.cos(φ), np.sin(φ)
-        R_t, R_n = c * R[0] + s * R[1], -s * R[0] + c * R[1]
-        δ_t, δ_n = c * δ[0] + s * δ[1], -s * δ[0] + c * δ[1]
-        scale = 1.0 / (2.0 * model.width * t.closure_length)
-        gi = max(scale * (R_n * δ_n + R[2] * δ[2]), 0.0)
-        gii = scale * R_t * δ_t
-        out.append(TipRelease(t.debond, t.tip, gi + gii, gi, gii, t.closure_length))
-    return out
-
-
+    return [_closure(model, u_full, f_full, t, elements) for t in tips]
 
 
 def release_columns(model: BeamModel, u: np.ndarray, tips: list[BeamTip]
@@ -159,30 +175,44 @@ def _frame(model: BeamModel, u_full: np.ndarray, t: BeamTip) -> tuple[float, flo
 
 
 def closure_release(model: BeamModel, u: np.ndarray, t: BeamTip, elements: int) -> TipRelease:
-    """G over a closure length of ``elements`` tip elements (a diagnostic of the VCCT estimate).
+    """G over a closure length of ``elements`` tip elements (see the module docstring).
 
-    Δ = the distance from the tip node to the ``elements``-th untied node behind it. The tie
-    reactions R_k of the bonded nodes ahead of the tip at s_k < Δ (tip node included) close the
-    jumps δ found at the mirrored distance Δ − s_k behind (linear interpolation between the
-    untied nodes): G = Σ_k R_k · δ(Δ − s_k) / (2 b Δ), the discrete closure integral
-    ∫₀^Δ t(s) δ(Δ − s) ds / (2Δ) with the ties' force representation, as in 2D
-    (reference2d/fracture.py). ``elements = 1`` is :func:`tip_releases`.
+    Δ = the distance from the tip node to the ``elements``-th untied node behind it (fewer if
+    the debond has fewer). The tie reactions R_k of the bonded nodes ahead of the tip at
+    s_k < Δ (tip node included) close the jumps δ found at the mirrored distance Δ − s_k
+    behind (linear interpolation between the untied nodes): G = Σ_k R_k · δ(Δ − s_k) / (2 b Δ),
+    the discrete closure integral ∫₀^Δ t(s) δ(Δ − s) ds / (2Δ) with the ties' force
+    representation, as in 2D (reference2d/fracture.py).
     """
     u_full = model.expand(u)
     f_full = model.full_response(u_full, tangent=False)[0]
+    return _closure(model, u_full, f_full, t, elements)
+
+
+def _tied(model: BeamModel, interface: str, node: int) -> bool:
+    """Whether the tie pairs of ``interface`` at ``node`` are eliminated (bonded or clamped)."""
+    core, face = tie_dofs(interface, node)
+    free = model.dof_map.free
+    return bool(np.all(free[core] == free[face]))
+
+
+def _closure(model: BeamModel, u_full: np.ndarray, f_full: np.ndarray, t: BeamTip,
+             elements: int) -> TipRelease:
     x = model.mesh.x
     back = int(np.sign(t.behind - t.node))
     n_nodes = len(x)
-    behind_nodes = [t.node + back * k for k in range(0, elements + 1)
-                    if 0 <= t.node + back * k < n_nodes]
+    behind_nodes = [t.node]
+    k = t.node + back
+    while len(behind_nodes) <= elements and 0 <= k < n_nodes and not _tied(model, t.interface, k):
+        behind_nodes.append(k)
+        k += back
     if len(behind_nodes) < 2:
         return TipRelease(t.debond, t.tip, 0.0, 0.0, 0.0, 0.0)
     delta = float(abs(x[behind_nodes[-1]] - x[t.node]))
-    # jumps at the nodes behind (distance r from the tip); r = 0 at the tip itself (tied: 0)
-    r_b = np.abs(x[behind_nodes] - x[t.node])
+    r_b = np.abs(x[behind_nodes] - x[t.node])  # distance behind the tip of each node
     jumps = np.array([u_full[tie_dofs(t.interface, k)[1]] - u_full[tie_dofs(t.interface, k)[0]]
-                      for k in behind_nodes])
-    jumps[0] = 0.0
+                      for k in behind_nodes])  # sliding, opening (mm), rotation jump (rad)
+    jumps[0] = 0.0  # the tip node is tied
     c, s = _frame(model, u_full, t)
     work_n = work_t = 0.0
     k = t.node
@@ -190,8 +220,7 @@ def closure_release(model: BeamModel, u: np.ndarray, t: BeamTip, elements: int) 
         s_k = abs(x[k] - x[t.node])
         if s_k >= delta * (1.0 - 1e-9):
             break
-        core, _ = tie_dofs(t.interface, k)
-        R = f_full[core]
+        R = f_full[tie_dofs(t.interface, k)[0]]  # face on core: N, N, N·mm
         d = np.array([np.interp(delta - s_k, r_b, jumps[:, j]) for j in range(3)])
         R_t, R_n = c * R[0] + s * R[1], -s * R[0] + c * R[1]
         d_t, d_n = c * d[0] + s * d[1], -s * d[0] + c * d[1]
