@@ -16,15 +16,20 @@ n tip elements (the mesh fills a debond with its smallest elements):
 over the bonded nodes at the distance s_k < Δ ahead of the tip (the tip node included), δ
 interpolated linearly at the mirrored distance Δ − s_k behind it: the closure integral
 ∫₀^Δ t(s) δ(Δ − s) ds / (2Δ) with the ties' force representation, as in 2D. The history
-columns use n = ``CLOSURE_ELEMENTS`` = 1 (R at the tip node × δ at the first node behind,
-Δ = that element). Measured (``benchmarks/results/fracture/core_levels.md``, docs/fracture.md):
-on the closed-form cases one element is +0.6 % (core level 1) to +2.7 % (level 4) high and
-does not converge with the mesh at levels > 1 (a richer core concentrates the tie forces at the
-tip node), while 8 elements are within 0.3 % for levels 1-4 and 240-960 elements, the split
-included; but once a debonded face has buckled and peels at a large rotation (fig. 5 past
-the buckling) G falls with Δ (−7 % at 4 elements, −18 % at 8: the opening behind the tip is
-no longer self-similar over Δ), where one element stays consistent with the 2D J-integral
-trend. So the default stays one element; :func:`closure_release` gives the others.
+columns use n = round(t / h) ≥ 1 elements of length h at the tip, t the thinner face's
+thickness (:func:`closure_elements`): Δ ≈ t, the 2D model's default closure length, so both
+models close the crack over the same physical length whatever the mesh or the core level.
+
+Measured (``benchmarks/results/fracture/core_levels.md``, docs/fracture.md): on the closed-form
+cases, Δ ≈ t is within 1.1 % of closed form for core levels 1-4 and 240-960 elements, its
+split (G_II/G 0.96-0.98 sliding) independent of both. One element (R at the tip node × δ at
+the first node behind, the estimate until 2026-12-01) was +0.6 % (level 1) to +2.7 % (level 4)
+high and did not converge with the mesh at levels > 1 (a richer core concentrates the tie
+forces at the tip node); 8 elements were within 0.3 % there, but once a debonded face peels
+at a large rotation (fig. 5 past its buckling) G falls with Δ beyond about two face
+thicknesses in both models (beam: −18 % at 8 elements = 2.3 mm; 2D: −11 % at 2 mm, while
+Δ ≤ 1 mm agree with its J-integral within 2 %): the opening behind the tip is no longer
+self-similar over Δ. Δ ≈ t is inside that range.
 
 Mode split (the beam-theory, "global" partition): G_II from the tangential forces × sliding,
 G_I from the normal forces × opening plus the interface moments × the rotation jumps (a moment
@@ -53,7 +58,6 @@ from sandwich.results.fracture import TipRelease, column_names, history_columns 
 BeamModel = Any
 
 TIE_ROLES = ("u", "w", "w,x")  # order of the pairs in dofs.TIES
-CLOSURE_ELEMENTS = 1  # tip elements of closure of the history columns (see above)
 # A core level (beam_element.core_levels) that changes near a tip biases G (measured on the
 # closed-form cases, core 10 mm, 8-element closure; benchmarks/results/fracture/core_levels.md):
 # a level patch of 5 elements each side of the tip (transitions 0.4-0.8 mm behind it) −3 …
@@ -131,18 +135,26 @@ def tie_dofs(interface: str, node: int | np.ndarray) -> tuple[np.ndarray, np.nda
     return core, face
 
 
+def closure_elements(model: BeamModel, t: BeamTip) -> int:
+    """Tip elements of the history's closure: round(t_face / h_tip) ≥ 1 (Δ ≈ t_face)."""
+    face = min(float(v) for v in model.face_thickness.values())
+    return max(1, int(round(face / t.closure_length)))
+
+
 def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip],
-                 elements: int = CLOSURE_ELEMENTS) -> list[TipRelease]:
+                 elements: int | None = None) -> list[TipRelease]:
     """G, G_I, G_II at ``tips`` for the free DOF vector ``u``: :func:`closure_release`.
 
-    ``elements`` tip elements of closure (default :data:`CLOSURE_ELEMENTS` = 1: the tip node's
-    reaction × the jumps at the first node behind; fewer if the debond has fewer).
+    ``elements`` tip elements of closure; default :func:`closure_elements` (Δ ≈ the thinner
+    face's thickness, as in 2D). The :class:`TipRelease` records the Δ used (mm).
     """
     if not tips:
         return []
     u_full = model.expand(u)
     f_full = model.full_response(u_full, tangent=False)[0]
-    return [_closure(model, u_full, f_full, t, elements) for t in tips]
+    return [_closure(model, u_full, f_full, t,
+                     closure_elements(model, t) if elements is None else elements)
+            for t in tips]
 
 
 def release_columns(model: BeamModel, u: np.ndarray, tips: list[BeamTip]

@@ -4,8 +4,10 @@ Why does the beam's G move with the core level (docs/fracture.md "Beam core leve
 closed-form cases of ``tests/fracture/fracture_cases.py`` (peel couple, sliding couples,
 cantilever face slope), geometrically linear (λ = 1, one linear solve), this measures
 
-- the closure estimate of :func:`beam_element.fracture.closure_release` over Δ = 1 (the
-  history columns' one-element VCCT), 2, 4, 8 tip elements;
+- the history columns' estimate (:func:`beam_element.fracture.tip_releases`: closure over
+  Δ ≈ the face thickness, round(t/h) tip elements), and the closure of
+  :func:`beam_element.fracture.closure_release` over Δ = 1 (the one-element VCCT used until
+  2026-12-01), 2, 4, 8 tip elements;
 - the energy released by untying the tip node (Clapeyron, two linear solves at fixed load: the
   discrete model's own G over one element, independent of any closure formula),
 
@@ -40,7 +42,7 @@ from fracture_cases import (  # noqa: E402
 )
 
 from beam_element.constraints import NodeSupport, build_dof_map  # noqa: E402
-from beam_element.fracture import beam_tips, closure_release  # noqa: E402
+from beam_element.fracture import beam_tips, closure_release, tip_releases  # noqa: E402
 from beam_element.model import build_model  # noqa: E402
 from beam_element.solve import linear_solution  # noqa: E402
 
@@ -65,12 +67,12 @@ def _untied(model, sc, node):
 
 
 def measure(sc, levels, elements):
-    """(8-element G, closure G over CLOSURES, extension G) at λ = 1 for ``levels``."""
+    """(history G, closure G over CLOSURES, extension G) at λ = 1 for ``levels``."""
     model = build_model(sc, elements=elements, core_level=levels)
     tip = beam_tips(sc, model)[0]
     u, _ = linear_solution(model, 1.0)
     closure = [closure_release(model, u, tip, n) for n in CLOSURES]
-    g = closure[-1]  # the split reported: the 8-element one (level-independent)
+    g = tip_releases(model, u, [tip])[0]  # the history columns' estimate (Δ ≈ t_face)
     longer = _untied(model, sc, tip.node)
     u2, _ = linear_solution(longer, 1.0)
     work = longer.f_ref @ u2 - model.f_ref @ u  # twice the energy released at fixed load
@@ -125,7 +127,7 @@ def run(args):
                                  for a, b in zip(out[0][:-1], out[1][:-1], strict=True)
                                  ) + (out[1][-1],)
                 rows.append({"case": name, "config": config, "elements": elements,
-                             **{f"closure_{n}": v for n, v in
+                             "history": vals[0], **{f"closure_{n}": v for n, v in
                                                  zip(CLOSURES, vals[1:-2], strict=True)},
                              "extension": vals[-2], "GII_over_G": vals[-1],
                              "seconds": time.perf_counter() - t0})
@@ -144,15 +146,17 @@ def write(rows, stem):
              f"{os.getloadavg()[0]:.1f})", "",
              "λ = 1, one linear solve. `uniform:k` = level k everywhere; `patch:k:p` = level k "
              "on p elements each side of the tip, 1 elsewhere. "
-             "Δ=n = closure over n tip elements (Δ=1: the history columns' one-element VCCT); "
+             "history = the G columns' estimate (closure over Δ ≈ the face thickness, "
+             "round(t/h) tip elements); Δ=n = closure over n tip elements (Δ=1: the "
+             "one-element VCCT of the G columns until 2026-12-01); "
              "extension = energy of untying the tip node at fixed load (the discrete model's "
              "own G over one element). Cantilever: slope d√G/da / closed form. G_II/G of the "
-             "8-element closure (at a = 60 for the cantilever).", "",
-             "| case | config | el. | " + " | ".join(f"Δ={n}" for n in CLOSURES)
+             "history estimate (at a = 60 for the cantilever).", "",
+             "| case | config | el. | history (Δ≈t) | " + " | ".join(f"Δ={n}" for n in CLOSURES)
              + " | extension | G_II/G |",
-             "|---" * (5 + len(CLOSURES)) + "|"]
+             "|---" * (6 + len(CLOSURES)) + "|"]
     for r in rows:
-        lines.append(f"| {r['case']} | {r['config']} | {r['elements']} | "
+        lines.append(f"| {r['case']} | {r['config']} | {r['elements']} | {r['history']:.4f} | "
                      + " | ".join(f"{r[f'closure_{n}']:.4f}" for n in CLOSURES)
                      + f" | {r['extension']:.4f} | {r['GII_over_G']:.3f} |")
     (OUT / f"{stem}.md").write_text("\n".join(lines) + "\n")

@@ -140,8 +140,8 @@ def main() -> None:
                                      j[k] if model == "2d" else ""])
         lines = [f"# G along the path: {scene.name}", "",
                  f"Beam: {sols['beam'].extra.get('elements')} elements, core "
-                 f"{scene.beam_model.core}, closure over 8 tip elements "
-                 f"(beam_element.fracture.CLOSURE_ELEMENTS). 2D: level {args.level}, "
+                 f"{scene.beam_model.core}, closure over Δ ≈ the thinner face "
+                 f"thickness (beam_element.fracture.closure_elements). 2D: level {args.level}, "
                  f"{sols['2d'].extra.get('cells')} cells, VCCT closure length "
                  f"{sols['2d'].extra.get('vcct_closure_length')} mm, J-integral disc radius "
                  f"{sols['2d'].extra.get('j_radius')} mm. "
