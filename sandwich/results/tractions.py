@@ -67,7 +67,8 @@ def tip_rows(scene: object, profile: Profile, model: str | None = None) -> list[
         pick = np.flatnonzero((s >= -BEHIND * h) & (s <= AHEAD * h))
         pick = pick[np.argsort(s[pick], kind="stable")]
         for k in pick:
-            row: list[object] = [profile.step, t.debond, t.tip, t.interface, repr(float(s[k])),
+            dist = float(s[k]) + 0.0  # no "-0.0" at the tip
+            row: list[object] = [profile.step, t.debond, t.tip, t.interface, repr(dist),
                                  repr(float(x[k])), _num(sz[k]),
                                  "" if tau is None else _num(tau[k])]
             rows.append(row if model is None else [model, *row])
