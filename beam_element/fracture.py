@@ -59,10 +59,10 @@ BeamModel = Any
 
 TIE_ROLES = ("u", "w", "w,x")  # order of the pairs in dofs.TIES
 # A core level (beam_element.core_levels) that changes near a tip biases G (measured on the
-# closed-form cases, core 10 mm, 8-element closure; benchmarks/results/fracture/core_levels.md):
-# a level patch of 5 elements each side of the tip (transitions 0.4-0.8 mm behind it) −3 …
-# −22 %; transitions 1.2 mm behind / 7.5 mm ahead +1.5/+2.5 %, 2.5 / 15 mm ≤ 1.2 %, 5 / 31 mm
-# ≤ 0.3 %. Warned within the larger of this many elements and LEVEL_ZONE core thicknesses.
+# closed-form cases, core 10 mm; benchmarks/results/fracture/core_levels.md): level patches of
+# 2-6 elements each side of the tip −6 … +4 % with the Δ ≈ t closure (one element −19 … +4 %),
+# a patch reaching 5 mm (half the core) behind the tip ≤ 1 %. Warned within the larger of
+# this many elements and LEVEL_ZONE core thicknesses of a tip.
 LEVEL_NEIGHBOURHOOD = 8
 LEVEL_ZONE = 0.5
 
