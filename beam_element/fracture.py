@@ -99,6 +99,38 @@ def beam_tips(scene: object, model: BeamModel) -> list[BeamTip]:
     return out
 
 
+def tip_zones(model: BeamModel, tips: list[BeamTip]) -> list[np.ndarray]:
+    """Per tip, the elements where the core level should not change (a boolean mask).
+
+    Those within :data:`LEVEL_NEIGHBOURHOOD` elements or :data:`LEVEL_ZONE` core thicknesses
+    of the tip, whichever reaches farther.
+    """
+    n = model.mesh.n_elements
+    x = model.mesh.x
+    centres = 0.5 * (x[:-1] + x[1:])
+    reach = LEVEL_ZONE * float(model.layers["core"].thickness)
+    out = []
+    for t in tips:
+        near = np.zeros(n, dtype=bool)
+        near[max(min(t.node, t.behind) - LEVEL_NEIGHBOURHOOD, 0):
+             min(max(t.node, t.behind) + LEVEL_NEIGHBOURHOOD, n)] = True
+        near |= np.abs(centres - x[t.node]) < reach
+        out.append(near)
+    return out
+
+
+def uniform_tip_levels(model: BeamModel, tips: list[BeamTip], levels: np.ndarray) -> np.ndarray:
+    """``levels`` with every tip zone (:func:`tip_zones`) raised to the highest level in it.
+
+    What the automatic level choice should apply after each choice or raise so that no level
+    transition falls next to a tip (docs/fracture.md; not called by beam_element.solve yet).
+    """
+    out = np.array(levels, dtype=int, copy=True)
+    for near in tip_zones(model, tips):
+        out[near] = out[near].max()
+    return out
+
+
 def level_warning(model: BeamModel, tips: list[BeamTip]) -> str:
     """A warning naming the tips whose neighbourhood has mixed core levels, or ``""``.
 
@@ -108,23 +140,13 @@ def level_warning(model: BeamModel, tips: list[BeamTip]) -> str:
     levels = getattr(model, "element_levels", None)
     if levels is None:
         return ""
-    x = model.mesh.x
-    centres = 0.5 * (x[:-1] + x[1:])
-    reach = LEVEL_ZONE * float(model.layers["core"].thickness)
-    bad = []
-    for t in tips:
-        lo = max(min(t.node, t.behind) - LEVEL_NEIGHBOURHOOD, 0)
-        hi = min(max(t.node, t.behind) + LEVEL_NEIGHBOURHOOD, len(levels))
-        near = np.zeros(len(levels), dtype=bool)
-        near[lo:hi] = True
-        near |= np.abs(centres - x[t.node]) < reach
-        if len(np.unique(levels[near])) > 1:
-            bad.append(f"{t.debond}_{t.tip}")
+    bad = [f"{t.debond}_{t.tip}" for t, near in zip(tips, tip_zones(model, tips), strict=True)
+           if len(np.unique(levels[near])) > 1]
     if not bad:
         return ""
     return (f"the core level changes within {LEVEL_ZONE:g} core thickness (or "
             f"{LEVEL_NEIGHBOURHOOD} elements) of debond tip(s) {', '.join(bad)}: G there is "
-            "biased, by up to tens of per cent for a short patch (set a uniform [beam_model] "
+            "biased (measured −6 … +4 % on closed-form cases; set a uniform [beam_model] "
             "core level or a core_zones entry over the tip; docs/fracture.md)")
 
 
