@@ -113,3 +113,12 @@ def test_extremes_wall_time_cap_keeps_the_streamed_states(scene, synth):
         "beam", "converged", synth.make_solution("beam"))})
     assert r["2d_reached"] == pytest.approx(3.0 / 15.0)
     assert r["common"] == pytest.approx(0.2) and "2D stopped early" in r["agree_note"]
+
+
+def test_tradeoff_variants_set_the_core_level(scene):
+    """``paper``/``averaged`` are the paper's core (level 1), ``L<k>`` level k, ``auto`` auto."""
+    cases = {"paper": (1, "paper"), "averaged": (1, "averaged"), "L3": (3, "paper"),
+             "auto": ("auto", "paper")}
+    for variant, (core, membrane) in cases.items():
+        bm = tradeoff.with_beam_elements(scene, 30, variant).beam_model
+        assert (bm.core, bm.face_membrane, bm.elements) == (core, membrane, 30), variant
