@@ -84,7 +84,8 @@ def profile_columns(
     """Profile columns along x (mm, MPa): face deflections, interface σ_z, core τ, contact.
 
     Columns: ``x, w_top, w_bottom, sigma_zz_top, sigma_zz_bottom, tau_core`` (core σ_z at the
-    core's top/bottom boundary, core τ at mid-core), ``u_top, u_bottom`` (axial displacement of
+    core's top/bottom boundary, core τ at mid-core), ``tau_top, tau_bottom`` (core τ at its
+    top/bottom boundary: the interface shear traction), ``u_top, u_bottom`` (axial displacement of
     the faces' mid-surfaces), ``sigma_xx_top_face, sigma_xx_bottom_face`` (face σ_x at
     mid-thickness), ``p_contact_top, p_contact_bottom`` (contact pressure, zero where bonded or
     open) and ``gap_top, gap_bottom`` (normal gap of debonded pairs, zero where bonded).
@@ -106,6 +107,8 @@ def profile_columns(
         "sigma_zz_top": col("core", 1.0, "sigma_z"),
         "sigma_zz_bottom": col("core", -1.0, "sigma_z"),
         "tau_core": col("core", 0.0, "tau"),
+        "tau_top": col("core", 1.0, "tau"),  # interface shear tractions (tip_tractions.csv)
+        "tau_bottom": col("core", -1.0, "tau"),
         "u_top": col("top", 0.0, "u"),
         "u_bottom": col("bottom", 0.0, "u"),
         "sigma_xx_top_face": col("top", 0.0, "sigma_x"),

@@ -33,6 +33,7 @@ from beam_element.element import (
     layer_state,
     layer_tangent,
 )
+from beam_element.fracture import beam_tips, release_columns
 from beam_element.layer_operators import (
     LayerOperators,
     build_core_operators,
@@ -122,6 +123,8 @@ class BeamModel:
     smoothing: float = 0.0  # contact regularisation width s (mm), see beam_element.contact
     core: list[CoreGroup] = field(default_factory=list)  # core elements grouped by level
     element_levels: np.ndarray | None = None  # core level of every element
+    # debond tips (beam_element.fracture.BeamTip) whose G every accepted path state carries
+    fracture_tips: list = field(default_factory=list)
     pattern: ReducedPattern = field(init=False)
     committed: dict[str, ContactSummary] = field(default_factory=dict)
     max_penetration_seen: float = 0.0
@@ -230,6 +233,14 @@ class BeamModel:
         if name not in self.probe_rows:
             raise ValueError(f"unknown probe {name!r}; known: {sorted(self.probe_rows)}")
         return self.dof_map.reduce(self.probe_rows[name])
+
+    def state_columns(self, u: np.ndarray) -> dict[str, float | None]:
+        """History columns of a converged state: G, G_I, G_II at every debond tip (N/mm).
+
+        Called by the path follower on every accepted state, so that a run interrupted
+        mid-path still writes them (:mod:`beam_element.fracture`).
+        """
+        return release_columns(self, u, self.fracture_tips)
 
     def commit(self, u: np.ndarray, load_factor: float) -> None:
         """Record the contact state of a converged step."""
@@ -599,12 +610,14 @@ def build_model(
         contact_penalty = PENALTY_FACTOR * stiffness["core"][1, 1] / hc
     if contact_smoothing is None:
         contact_smoothing = SMOOTHING_FRACTION * PENETRATION_BOUND * min(ht, hb)
-    return BeamModel(
+    model = BeamModel(
         name=scene.name, mesh=mesh, width=float(scene.width), layers=layers, products=products,
         dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,
         probe_rows=probes, face_thickness={"top": ht, "bottom": hb},
         smoothing=float(contact_smoothing), core=groups, element_levels=levels,
     )
+    model.fracture_tips = beam_tips(scene, model)
+    return model
 
 
 def beam_mesh(

@@ -7,8 +7,11 @@ the plot overlays G, G_I and G_II against that probe. The 2D model also reports 
 J-integral (``reference2d.jintegral``, disc of 4 face thicknesses) as a cross-check of its G.
 
 Run: ``XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/fracture_paths.py [--level medium]
-[--scenes fig5 c2 c3]``. Writes ``benchmarks/results/fracture/<scene>_<level>.md``, ``.csv`` and
-``.png``.
+[--scenes fig5 c2 c3] [--reuse-2d] [--core 1]``. Writes
+``benchmarks/results/fracture/<scene>_<level>[_core<k>].md``, ``.csv`` and ``.png``.
+``--reuse-2d`` reads the 2D rows (G, split, J per converged step) from the stored
+``<scene>_<level>.csv`` instead of solving the 2D model again (hours on this machine at
+medium); ``--core`` sets the beam's ``[beam_model] core`` (default: the scene's).
 """
 
 from __future__ import annotations
@@ -55,6 +58,26 @@ def _solve(scene, model: str, level: str):
     return sol
 
 
+def _stored_2d(stem: Path, probe: str):
+    """The 2D rows of a stored table as a Solution (history: probe, λ, G/GI/GII/J per tip)."""
+    from sandwich.results import Solution, StepRecord
+
+    by_step: dict[int, StepRecord] = {}
+    with open(f"{stem}.csv", newline="") as fh:
+        for row in csv.DictReader(fh):
+            if row["model"] != "2d":
+                continue
+            k = int(row["step"])
+            rec = by_step.setdefault(k, StepRecord(k, float(row["load_factor"]),
+                                                   {probe: float(row[probe])}, 0, {}))
+            for p in ("G", "GI", "GII", "J"):
+                if row[p] != "":
+                    rec.extra[f"{p}_{row['tip']}"] = float(row[p])
+    return Solution("2d", stem.name, [by_step[k] for k in sorted(by_step)], [], True,
+                    f"rows reused from {stem.name}.csv (not solved again)", [], 0.0, 0,
+                    {"cells": "stored", "vcct_closure_length": "stored", "j_radius": "stored"})
+
+
 def _tips(sol) -> list[str]:
     return sorted({k[2:] for r in sol.history for k in r.extra if k.startswith("G_")})
 
@@ -85,18 +108,27 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--level", default="medium")
     ap.add_argument("--scenes", nargs="+", default=list(SCENES))
+    ap.add_argument("--reuse-2d", action="store_true")
+    ap.add_argument("--core", default=None, help="beam core level (1…6 or auto)")
     args = ap.parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
     load = os.getloadavg()[0]
     for key in args.scenes:
         scene = load_scene(ROOT / "scenes" / f"{SCENES[key]}.toml")
+        if args.core is not None:
+            import dataclasses
+
+            core = args.core if args.core == "auto" else int(args.core)
+            scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+                scene.beam_model, core=core))
         probe = scene.analysis.until_probe
         sols, walls = {}, {}
         for model in ("beam", "2d"):
             t0 = time.perf_counter()
-            sols[model] = _solve(scene, model, args.level)
+            sols[model] = (_stored_2d(OUT / f"{key}_{args.level}", probe)
+                           if model == "2d" and args.reuse_2d else _solve(scene, model, args.level))
             walls[model] = time.perf_counter() - t0
-        stem = OUT / f"{key}_{args.level}"
+        stem = OUT / (f"{key}_{args.level}" + (f"_core{args.core}" if args.core else ""))
         with open(f"{stem}.csv", "w", newline="") as fh:
             wr = csv.writer(fh)
             wr.writerow(["model", "tip", "step", "load_factor", probe, "G", "GI", "GII", "J"])
@@ -107,8 +139,9 @@ def main() -> None:
                         wr.writerow([model, tip, k, lam[k], w[k], g[k], gi[k], gii[k],
                                      j[k] if model == "2d" else ""])
         lines = [f"# G along the path: {scene.name}", "",
-                 f"Beam: {sols['beam'].extra.get('elements')} elements, closure = the element "
-                 f"behind the tip. 2D: level {args.level}, "
+                 f"Beam: {sols['beam'].extra.get('elements')} elements, core "
+                 f"{scene.beam_model.core}, closure over Δ ≈ the thinner face "
+                 f"thickness (beam_element.fracture.closure_elements). 2D: level {args.level}, "
                  f"{sols['2d'].extra.get('cells')} cells, VCCT closure length "
                  f"{sols['2d'].extra.get('vcct_closure_length')} mm, J-integral disc radius "
                  f"{sols['2d'].extra.get('j_radius')} mm. "

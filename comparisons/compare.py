@@ -1,10 +1,13 @@
 """``compare``: both models on one scene, written into one folder.
 
-Overlay figures (PNG + CSV each), deformed pictures and ``metrics.json``.
+Overlay figures (PNG + CSV each), G at every debond tip along the path (``G_<tip>.png``,
+``energy_release.csv``), the interface tractions ahead of each tip (``tip_tractions.csv``),
+deformed pictures and ``metrics.json``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -19,6 +22,8 @@ from comparisons.pair import BEAM, PAIR, REFERENCE
 from comparisons.paths import LOAD, Curve, limit_loads, path_parameter, series
 from comparisons.plots import Panel, overlay
 from comparisons.profiles import ChosenProfile, choose_common
+from comparisons.releases import release_curve, tips
+from comparisons.tip_tractions import write_tip_tractions
 from models import ModelRun, Progress, Solver, obtain
 from sandwich.results import Solution, atomic_write_text
 from sandwich.scene import Scene
@@ -88,6 +93,50 @@ def _path_figures(cmp: Comparison) -> None:
                             f"{probe.name} (mm)", f"{cmp.scene.name}: load vs {probe.name}{until}")
         cmp.figures.append(png)
         cmp.tables.append(csv_)
+
+
+def _release_figures(cmp: Comparison, abscissa: str) -> None:
+    """Per debond tip: G and its split in both models against |path parameter|, + a table."""
+    sols = cmp.solutions
+    found = sorted({t for m in (REFERENCE, BEAM) for t in tips(sols.get(m))})
+    for tip in found:
+        total, parts = [], []
+        for model in (REFERENCE, BEAM):
+            s = sols.get(model)
+            if s is None or not s.history or tip not in tips(s):
+                continue
+            total.append(dataclasses.replace(release_curve(s, abscissa, tip), label=model))
+            parts += [dataclasses.replace(release_curve(s, abscissa, tip, p), label=f"{model} {p}")
+                      for p in ("GI", "GII")]
+        debond, end = tip.split("_")
+        panels = [Panel("G (N/mm)", total, title=f"debond {debond}, {end} tip"),
+                  Panel("G_I, G_II (N/mm)", parts, title="split (each model's own partition)")]
+        png, csv_ = overlay(cmp.out_dir / f"G_{tip}.png", panels, f"|{abscissa}|",
+                            f"{cmp.scene.name}: energy release rate vs |{abscissa}|")
+        cmp.figures.append(png)
+        cmp.tables.append(csv_)
+    if cmp.metrics.releases:
+        cmp.tables.append(_release_table(cmp))
+
+
+def _release_table(cmp: Comparison) -> Path:
+    """``energy_release.csv``: the agreement of G per tip (the numbers of metrics.json)."""
+    def num(v: object) -> str:
+        return "" if v is None else repr(float(v))  # type: ignore[arg-type]
+
+    rows = ["tip,abscissa,common_from,common_to,l2_relative,max_relative,ratio_beam_over_2d,"
+            "G_2d_at_end,G_beam_at_end,GII_over_G_2d,GII_over_G_beam,note"]
+    for r in cmp.metrics.releases:
+        lo, hi = r.common_range or (None, None)
+        rows.append(",".join([r.tip, r.abscissa, num(lo), num(hi), num(r.l2_relative),
+                              num(r.max_relative), num(r.ratio_at_end),
+                              num(r.G_at_end.get(REFERENCE)), num(r.G_at_end.get(BEAM)),
+                              num(r.mode_ii_share_at_end.get(REFERENCE)),
+                              num(r.mode_ii_share_at_end.get(BEAM)),
+                              '"' + r.note.replace('"', "'") + '"']))
+    path = cmp.out_dir / "energy_release.csv"
+    atomic_write_text(path, "\n".join(rows) + "\n")
+    return path
 
 
 def _profile_curves(chosen: Mapping[str, ChosenProfile], column: str, suffix: str = ""
@@ -195,6 +244,8 @@ def compare(scene: Scene | str | Path, out_dir: str | Path, *, reuse: bool = Tru
         chosen = choose_common(present, abscissa)
         cmp.chosen_profiles = {c.model: c for c in chosen or []}
     _path_figures(cmp)
+    _release_figures(cmp, abscissa)
+    cmp.tables += write_tip_tractions(scene, cmp.chosen_profiles, out_dir)
     _profile_figures(cmp, abscissa)
     _deformed_figures(cmp)
     atomic_write_text(out_dir / "metrics.json",

@@ -13,6 +13,9 @@ Definitions (all relative errors are of the beam against the 2D reference):
   ``PEAK_WINDOW`` mm (a force per unit length over that window, which converges);
 - limit loads: maxima of the load factor that the path falls from (detected on each history), and
   those the model itself reported;
+- energy release rate: G along the path at every debond tip both models report
+  (:mod:`comparisons.releases`: L2/max error of G, beam/2D ratio and each model's G_II/G at the
+  end of the common range);
 - cost: wall time and DOFs of each model, and the 2D / beam ratios.
 """
 
@@ -32,6 +35,7 @@ from comparisons.profiles import (
     peak_error,
     profile_error,
 )
+from comparisons.releases import ReleaseAgreement, release_agreements
 from models import ModelRun
 from sandwich.results import Solution
 
@@ -78,6 +82,7 @@ class Metrics:
     peaks: list[PeakError] = field(default_factory=list)
     peaks_windowed: list[PeakError] = field(default_factory=list)
     peak_window: float = 0.0  # mm, width of the averaging window of ``peaks_windowed``
+    releases: list[ReleaseAgreement] = field(default_factory=list)  # G per debond tip
     first_limit_load_error: float | None = None
     wall_ratio: float | None = None  # 2D wall time / beam wall time
     dofs_ratio: float | None = None  # 2D DOFs / beam DOFs
@@ -90,6 +95,10 @@ class Metrics:
     def curve(self, quantity: str) -> CurveError | None:
         """The path-curve error of ``quantity`` (``"load_factor"`` or a probe name)."""
         return next((c for c in self.curves if c.quantity == quantity), None)
+
+    def release(self, tip: str) -> ReleaseAgreement | None:
+        """The G agreement at ``tip`` (``"<debond>_<tip>"``)."""
+        return next((r for r in self.releases if r.tip == tip), None)
 
     def profile(self, column: str) -> CurveError | None:
         """The profile error of ``column``."""
@@ -160,6 +169,7 @@ def compute_metrics(scene_name: str, runs: dict[str, ModelRun], abscissa: str) -
         metrics.notes.extend(n for n in (note_ref, note_beam) if n and n not in metrics.notes)
         metrics.curves.append(curve_error(c_ref, c_beam, q, f"|{abscissa}|"))
     _profile_metrics(metrics, beam, ref, abscissa)
+    metrics.releases = release_agreements(beam, ref, abscissa)
     lb, lr = metrics.models[BEAM].limit_loads, metrics.models[REFERENCE].limit_loads
     if lb and lr:
         metrics.first_limit_load_error = (lb[0].load_factor - lr[0].load_factor) / abs(

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from models.registry import get_model
+from sandwich.fracture import growth_onset, missing_releases
 from sandwich.results import (
     OutputError,
     RunIdentity,
@@ -102,10 +103,18 @@ def stored_identity(folder: Path) -> RunIdentity | None:
 
 
 def _partial(model: str, scene: Scene, states: list[StepRecord], seconds: float) -> Solution:
+    """The solution of an interrupted run: the streamed steps with the columns they carry."""
     last = f" after step {states[-1].step}" if states else " before any step converged"
-    return Solution(model, scene.name, list(states), [], False,
-                    f"interrupted{last}: the converged steps are kept (no profiles)", [],
-                    seconds, 0)
+    solution = Solution(model, scene.name, list(states), [], False,
+                        f"interrupted{last}: the converged steps are kept (no profiles)", [],
+                        seconds, 0)
+    onset = growth_onset(scene, solution.history)  # debonds with a toughness, up to here
+    if onset:
+        solution.extra["debond_growth"] = onset
+    empty = missing_releases(solution.history)
+    if empty:
+        solution.extra["G_warning"] = (f"G could not be evaluated at {empty} (cells left empty)")
+    return solution
 
 
 def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | None = None,
@@ -150,7 +159,8 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
             say(ProgressEvent(model, "note", message=note))
             return
         rec = StepRecord(int(state.step), float(state.load_factor),  # type: ignore[attr-defined]
-                         dict(state.probes), int(getattr(state, "iterations", 0)))  # type: ignore[attr-defined]
+                         dict(state.probes), int(getattr(state, "iterations", 0)),  # type: ignore[attr-defined]
+                         dict(getattr(state, "extra", None) or {}))  # e.g. G at the tips
         streamed.append(rec)
         say(ProgressEvent(model, "step", step=rec.step, load_factor=rec.load_factor,
                           probes=rec.probes))
@@ -162,19 +172,19 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
         partial = _partial(model, scene, streamed, time.perf_counter() - t0)
         partial.extra[IDENTITY_KEY] = {**identity.to_dict(), "complete": False}
         if mpi_rank() == 0:
-            _write(partial, folder)
+            _write(partial, folder, scene)
         say(ProgressEvent(model, "interrupted", step=len(streamed), message=partial.message))
         raise
     solution.extra[IDENTITY_KEY] = identity.to_dict()
     if mpi_rank() == 0:
-        _write(solution, folder)
+        _write(solution, folder, scene)
     return solution
 
 
-def _write(solution: Solution, folder: Path) -> None:
+def _write(solution: Solution, folder: Path, scene: Scene | None = None) -> None:
     """Write the result set; a failing write (a full disk) is an :class:`OutputError`."""
     try:
-        write_solution(solution, folder)
+        write_solution(solution, folder, scene)
     except OutputError:
         raise
     except OSError as exc:

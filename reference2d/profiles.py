@@ -2,7 +2,8 @@
 
 Stresses are second Piola–Kirchhoff components S = C : E in the reference (x, z) frame, as the beam
 element reports them: ``sigma_zz_top``/``sigma_zz_bottom`` is S_zz of the *core* at its top/bottom
-boundary (z = ±h_c/2, evaluated in the core cell), ``tau_core`` is S_xz at the core mid-plane.
+boundary (z = ±h_c/2, evaluated in the core cell), ``tau_core`` is S_xz at the core mid-plane,
+``tau_top``/``tau_bottom`` S_xz of the core at its top/bottom boundary (interface shear).
 Stations are the x of the mesh nodes on the top interface.
 """
 
@@ -45,6 +46,8 @@ class ProfileSampler:
             "w_top": (zt, None), "w_bottom": (zb, None),
             "sigma_zz_top": (0.5 * hc, self.core), "sigma_zz_bottom": (-0.5 * hc, self.core),
             "tau_core": (0.0, self.core),
+            # S_xz of the core at its boundaries: the interface shear tractions
+            "tau_top": (0.5 * hc, self.core), "tau_bottom": (-0.5 * hc, self.core),
         }
         self.n_owned_cells = msh.topology.index_map(2).size_local
         self.input_cell = np.asarray(msh.topology.original_cell_index, dtype=np.int64)
@@ -87,7 +90,8 @@ class ProfileSampler:
             if name.startswith("w_"):
                 vals[ok] = system.u.eval(p[ok], cells[ok])[:, 1]
             else:
-                comp = {"sigma_zz_top": 1, "sigma_zz_bottom": 1, "tau_core": 2}[name]
+                comp = {"sigma_zz_top": 1, "sigma_zz_bottom": 1, "tau_core": 2, "tau_top": 2,
+                        "tau_bottom": 2}[name]
                 vals[ok] = self.S.eval(p[ok], cells[ok])[:, comp]
             comm = self.model.disc.mesh.comm
             cols[name] = allreduce_array(comm, vals, MPI.SUM) if comm.size > 1 else vals

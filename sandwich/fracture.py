@@ -13,6 +13,7 @@ converged step where it is reached (or none, with the largest G/G_c of the path)
 from __future__ import annotations
 
 from sandwich.results import StepRecord
+from sandwich.results.fracture import column_names, is_release_column
 from sandwich.scene import Scene, Toughness
 
 CRITERION = "Benzeggagh-Kenane"
@@ -45,8 +46,10 @@ def growth_onset(scene: Scene, history: list[StepRecord]) -> dict[str, dict[str,
                                         "step": None}
             worst = 0.0
             for r in history:
-                g = float(r.extra.get(g_name, 0.0))
-                gi, gii = float(r.extra[f"GI_{i}_{tip}"]), float(r.extra[f"GII_{i}_{tip}"])
+                values = [r.extra.get(n) for n in column_names(i, tip)]
+                if any(v is None for v in values):
+                    continue  # an empty cell: G not evaluated at this step (G_warning says why)
+                g, gi, gii = (float(v) for v in values)
                 gc = bk_toughness(d.toughness, gi, gii)
                 worst = max(worst, g / gc)
                 if g >= gc and entry["step"] is None:
@@ -55,3 +58,21 @@ def growth_onset(scene: Scene, history: list[StepRecord]) -> dict[str, dict[str,
             entry["max_G_over_Gc"] = worst
             out[f"{i}_{tip}"] = entry
     return out
+
+
+def missing_releases(history: list[StepRecord]) -> str:
+    """Where G columns are empty (``None``): ``"<column> at step(s) …"`` joined, or ``""``."""
+    where: dict[str, list[int]] = {}
+    names = sorted({k for r in history for k in r.extra
+                    if is_release_column(k) and k.startswith("G_")})
+    for r in history:
+        for n in names:
+            if r.extra.get(n) is None:
+                where.setdefault(n, []).append(r.step)
+    return "; ".join(f"{n} at step(s) {_steps(s)}" for n, s in where.items())
+
+
+def _steps(steps: list[int]) -> str:
+    if len(steps) <= 6:
+        return ", ".join(map(str, steps))
+    return f"{steps[0]}…{steps[-1]} ({len(steps)})"

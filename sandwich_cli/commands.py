@@ -217,6 +217,12 @@ def _compare_and_report(args: argparse.Namespace, scene: Scene, out: Path,
     if curve is not None and curve.l2_relative is not None:
         _say(args, f"load-deflection curve, beam vs 2D: L2 error {100 * curve.l2_relative:.2f} %, "
              f"max {100 * curve.max_relative:.2f} % over the common range")
+    for g in cmp.metrics.releases:  # energy release rate per debond tip (G_<tip>.png)
+        if g.ratio_at_end is not None and g.l2_relative is not None:
+            hi = g.common_range[1] if g.common_range else 0.0
+            _say(args, f"G at debond tip {g.tip}, beam vs 2D: L2 error "
+                 f"{100 * g.l2_relative:.1f} %, beam/2D {g.ratio_at_end:.3f} at {g.abscissa} = "
+                 f"{hi:.4g}")
     if cmp.metrics.wall_ratio is not None:
         _say(args, f"cost: 2D took {cmp.metrics.wall_ratio:.1f}x the beam's wall time, "
              f"{cmp.metrics.dofs_ratio:.1f}x its DOFs")

@@ -181,6 +181,11 @@ def test_ctrl_c_in_a_real_solve_keeps_the_converged_steps(tmp_path):
     with open(out / "history.csv") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) >= 2 and float(rows[-1]["w_top_mid"]) < 0
+    # every kept step has the energy release rate of both debond tips (issue 14: they were lost)
+    assert all(r[c] != "" for r in rows for c in ("G_0_start", "G_0_end", "GI_0_end", "GII_0_end"))
+    assert all(float(r[c]) >= 0.0 for r in rows for c in ("G_0_start", "GI_0_end"))
+    assert float(rows[-1]["G_0_end"]) > 0.0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["converged"] is False and "interrupted after step" in summary["message"]
+    assert "G_warning" not in summary
     assert list(tmp_path.iterdir()) == [out]

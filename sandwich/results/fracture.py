@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
+
+COLUMN = re.compile(r"GI{0,2}_\d+_(start|end)")  # G_0_end, GI_0_end, GII_0_end
 
 
 @dataclass(frozen=True)
@@ -20,6 +23,11 @@ class TipRelease:
 def column_names(debond: int, tip: str) -> tuple[str, str, str]:
     """History columns of one tip: ``G_<debond>_<tip>``, ``GI_…``, ``GII_…`` (N/mm)."""
     return (f"G_{debond}_{tip}", f"GI_{debond}_{tip}", f"GII_{debond}_{tip}")
+
+
+def is_release_column(name: str) -> bool:
+    """Whether ``name`` is a G column (an empty cell there means "not evaluated")."""
+    return COLUMN.fullmatch(name) is not None
 
 
 def history_columns(releases: list[TipRelease]) -> dict[str, float]:

@@ -62,7 +62,8 @@ def _read_history(path: Path) -> list[StepRecord]:
             load_factor=float(row[i_lf]),
             probes={name: float(row[i_lf + 1 + k]) for k, name in enumerate(probe_cols)},
             iterations=int(row[i_it]),
-            extra={name: float(row[i_it + 1 + k]) for k, name in enumerate(extra_cols)},
+            extra={name: (None if row[i_it + 1 + k] == "" else float(row[i_it + 1 + k]))
+                   for k, name in enumerate(extra_cols)},  # empty: a G not evaluated
         ))
     return records
 

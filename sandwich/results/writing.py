@@ -8,7 +8,9 @@ A solve writes, as one set (:func:`write_solution`), into its folder:
   (interface normal stress at the core's top and bottom boundary, core shear at mid-core, MPa);
 - ``summary.json``: ``model, scene, converged, steps, final_load_factor, limit_points,
   wall_seconds, dofs`` and more;
-- ``fields.pvd`` + ``fields_NNNNN.vtu`` when the model returns 2D field frames (ParaView).
+- ``fields.pvd`` + ``fields_NNNNN.vtu`` when the model returns 2D field frames (ParaView);
+- ``tip_tractions.csv`` when the scene (given) has debond tips: σzz and τ of the interface
+  around each tip at every profile step (:mod:`sandwich.results.tractions`).
 """
 
 from __future__ import annotations
@@ -25,10 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
+from sandwich.results.fracture import is_release_column
+from sandwich.results.tractions import scene_tips, tip_tractions_csv
 from sandwich.results.types import PROFILE_COLUMNS, FieldFrame, Solution
 from sandwich.results.vtu import pvd_text, vtu_text
 
-RESULT_SET_NAMES = frozenset({"history.csv", "profiles.csv", "summary.json", "fields.pvd"})
+RESULT_SET_NAMES = frozenset({"history.csv", "profiles.csv", "summary.json", "fields.pvd",
+                              "tip_tractions.csv"})
 
 
 def _finite(value: float) -> float | None:
@@ -68,6 +73,14 @@ def _cell(value: object) -> object:
     return value
 
 
+def _extra_cell(extra: dict, name: str) -> object:
+    """A history cell: empty for a G column without a value (not evaluated), else 0 if absent."""
+    value = extra.get(name)
+    if value is None:
+        return "" if is_release_column(name) else _cell(0.0)
+    return _cell(value)
+
+
 def history_csv(solution: Solution) -> str:
     """Render ``history.csv``."""
     probe_names = list(solution.history[0].probes) if solution.history else []
@@ -75,7 +88,7 @@ def history_csv(solution: Solution) -> str:
     header = ["step", "load_factor", *probe_names, "iterations", *extra_names]
     rows = [
         [r.step, _cell(r.load_factor), *(_cell(r.probes[n]) for n in probe_names), r.iterations,
-         *(_cell(r.extra.get(n, 0.0)) for n in extra_names)]
+         *(_extra_cell(r.extra, n) for n in extra_names)]
         for r in solution.history
     ]
     return _csv_text(header, rows)
@@ -119,8 +132,12 @@ def summary_dict(solution: Solution) -> dict[str, object]:
     return out
 
 
-def result_texts(solution: Solution) -> dict[str, str]:
-    """Every file of ``solution``'s result set, by name (refuses non-finite values first)."""
+def result_texts(solution: Solution, scene: object | None = None) -> dict[str, str]:
+    """Every file of ``solution``'s result set, by name (refuses non-finite values first).
+
+    With ``scene``, also ``tip_tractions.csv`` when the scene has debond tips
+    (:mod:`sandwich.results.tractions`).
+    """
     files = {
         "history.csv": history_csv(solution),
         "profiles.csv": profiles_csv(solution),
@@ -128,6 +145,8 @@ def result_texts(solution: Solution) -> dict[str, str]:
     }
     if solution.fields:
         files.update(_field_files(solution.fields))
+    if scene is not None and scene_tips(scene):
+        files["tip_tractions.csv"] = tip_tractions_csv(scene, solution.profiles)
     return files
 
 
@@ -136,7 +155,7 @@ def is_result_file(name: str) -> bool:
     return name in RESULT_SET_NAMES or bool(re.fullmatch(r"fields_\d+\.vtu", name))
 
 
-def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
+def write_solution(solution: Solution, out_dir: Path, scene: object | None = None) -> list[Path]:
     """Write the result set of ``solution`` into ``out_dir`` as a whole; return its paths.
 
     The files are written into a temporary sibling folder which then takes the place of
@@ -153,7 +172,7 @@ def write_solution(solution: Solution, out_dir: Path) -> list[Path]:
         If ``out_dir`` cannot be a result folder (see :func:`check_output_folder`).
     """
     out_dir = Path(out_dir)
-    files = result_texts(solution)
+    files = result_texts(solution, scene)
     check_output_folder(out_dir)
     out_dir = Path(os.path.abspath(out_dir))
     foreign = out_dir.is_dir() and any(not is_result_file(f.name) and not f.name.startswith(".")

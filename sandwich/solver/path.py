@@ -21,6 +21,9 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
 - a converged step whose state the model declares inadmissible (optional
   ``system.admissible(u)`` returning a non-empty reason, e.g. an inverted element) is rejected
   like a failed one, so the path never leaves the model's domain of physical meaning;
+- a model may add history columns to every accepted state (optional ``system.state_columns(u)``
+  returning ``{name: value or None}``, kept in :attr:`PathState.extra`): a caller that
+  streams the states (an interrupted run) then has them without the model's post-processing;
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
   (it never grows after a cut step) and is clipped to [min_increment, max_increment].
@@ -166,6 +169,9 @@ class PathState:
     probes: dict[str, float]
     negative_pivots: int | None
     cuts: int = 0
+    # per-state history columns the model adds (``system.state_columns(u)``, optional): kept on
+    # the state so that an interrupted run still writes them (e.g. G at the debond tips)
+    extra: dict[str, float | None] = field(default_factory=dict)
 
 
 @dataclass
@@ -260,6 +266,8 @@ class _Follower:
         self.rescues: list[int] = []
         admissible = getattr(system, "admissible", None)
         self.admissible = admissible if callable(admissible) else None
+        columns = getattr(system, "state_columns", None)
+        self.state_columns = columns if callable(columns) else None
 
     # -- helpers -------------------------------------------------------------------------------
     def probes(self, u: np.ndarray) -> dict[str, float]:
@@ -274,6 +282,8 @@ class _Follower:
         state = PathState(len(self.states), u.copy(), float(lam), its, self.probes(u), neg, cuts)
         self.states.append(state)
         self.system.commit(state.u.copy(), state.load_factor)
+        if self.state_columns is not None:
+            state.extra.update(self.state_columns(state.u))
         return state
 
     def finish(self, reached: bool, message: str) -> PathResult:
