@@ -26,7 +26,13 @@ from beam_element.core_levels import (
     zone_levels,
 )
 from beam_element.fields import profile_columns, section_fields
-from beam_element.fracture import beam_tips, history_columns, level_warning, tip_releases
+from beam_element.fracture import (
+    beam_tips,
+    history_columns,
+    level_warning,
+    tip_releases,
+    uniform_tip_levels,
+)
 from beam_element.model import BeamModel, beam_mesh, build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
@@ -263,7 +269,9 @@ def run(
             # too, and the rerun measures what that does.
             zone = np.minimum(choice.levels + 1, top)
             inside = _local_zone_elements(scene, model)
-            raised_levels = np.where(inside, np.maximum(marked, zone), marked)
+            # no level change next to a debond tip: it biases G (docs/fracture.md)
+            raised_levels = uniform_tip_levels(model, beam_tips(scene, model),
+                                               np.where(inside, np.maximum(marked, zone), marked))
             if np.any(inside) and not np.any(raised_levels[inside] > choice.levels[inside]):
                 # The zones are at the cap: a rerun would raise only elements where the load
                 # error does not live, and its small change would read as convergence (demo
@@ -362,11 +370,14 @@ def choose_core_levels(scene: object, elements: int | None, options: dict) -> Le
         return build_model(scene, elements=n, gauss=gauss,
                            **{**options, "core_level": np.maximum(levels, floor)})
 
-    sign = _load_sign(build(floor), scene)
+    base = build(floor)
+    sign = _load_sign(base, scene)
     choice = auto_levels(build, lambda m: linear_solution(m, sign)[0], mesh.n_elements,
                          float(getattr(bm, "tolerance", 0.01)),
                          int(getattr(bm, "max_core_level", 3)), probe=scene.analysis.until_probe)
-    choice.levels = np.maximum(choice.levels, floor)
+    # no level change next to a debond tip: it biases G (docs/fracture.md)
+    choice.levels = uniform_tip_levels(base, beam_tips(scene, base),
+                                       np.maximum(choice.levels, floor))
     return choice
 
 

@@ -117,17 +117,28 @@ def test_virtual_extension_energy_converges_to_the_closed_form():
     assert abs(vcct_fine - 1.0) < 0.01 and abs(vcct_coarse - 1.0) < 0.01
 
 
-def test_mixed_core_levels_at_the_tip_are_flagged():
-    """"auto" puts a level-2 patch around the tip of the sliding case: the summary says so."""
-    from beam_element.fracture import LEVEL_NEIGHBOURHOOD
+def test_mixed_core_levels_at_the_tip_are_flagged_and_auto_keeps_the_tip_uniform():
+    """A level-2 zone ending 2 mm past the tip of the sliding case (x = 60) puts a level change
+    next to the tip: the summary says so. "auto" levels every tip zone
+    (:func:`beam_element.fracture.uniform_tip_levels`), so it has no such warning."""
+    import dataclasses
 
-    sc = scene(shear_loads(scene(peel_loads())), probe_on="bottom", elements=480, core="auto")
-    r = run(sc)
-    tip = beam_tips(sc, r.model)[0]
+    from beam_element.fracture import LEVEL_NEIGHBOURHOOD
+    from sandwich.scene import CoreZone
+
+    sc = scene(shear_loads(scene(peel_loads())), probe_on="bottom", elements=480, core=1)
+    zoned = dataclasses.replace(sc, beam_model=dataclasses.replace(
+        sc.beam_model, core_zones=(CoreZone(40.0, 62.0, 2),)))
+    r = run(zoned)
+    tip = beam_tips(zoned, r.model)[0]
     near = r.model.element_levels[tip.node - LEVEL_NEIGHBOURHOOD:tip.node + LEVEL_NEIGHBOURHOOD]
-    assert len(set(near)) > 1  # the situation the warning is about (measured: level 2 patch)
+    assert len(set(near)) > 1  # the situation the warning is about
     assert "core level changes" in r.solution.extra["G_warning"]
     assert "0_end" in r.solution.extra["G_warning"]
+    auto = run(scene(shear_loads(scene(peel_loads())), probe_on="bottom", elements=480,
+                     core="auto"))
+    assert auto.model.element_levels.max() > 1  # auto refined somewhere
+    assert "core level changes" not in auto.solution.extra.get("G_warning", "")
     uniform = run(scene(peel_loads(), elements=120))  # core = 1 everywhere: no warning
     assert "G_warning" not in uniform.solution.extra
 
