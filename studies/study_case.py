@@ -1,0 +1,123 @@
+"""One case of a study, solved where a worker runs it, and its record on disk.
+
+:func:`solve_case` is what the execution engine sends to a worker (a local process or a node of a
+Dask cluster): it solves the case's scene with the one runner (:func:`models.obtain`, which
+writes the result set and its :class:`~sandwich.results.RunIdentity`), reads the study's numbers
+off the solution (:mod:`studies.study_metrics`) and writes ``case.json`` beside the result set
+last, so a case folder with a ``case.json`` whose identity matches is a finished case. It never
+raises for a case's failure: a failing case is a record with its reason.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+from models import PROJECT_ROOT, get_model, obtain, stored_identity, with_options
+from sandwich.scene import MAX_CORE_LEVEL, Scene
+from studies.study_metrics import case_metrics
+
+CASE_FILE = "case.json"
+LOOKAHEAD = 2  # the indicator compares the case's core level with this many levels more
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(data, indent=1, default=str) + "\n", encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def read_record(folder: Path) -> dict[str, Any] | None:
+    """The ``case.json`` of a case folder (None if absent or unreadable)."""
+    try:
+        data = json.loads((Path(folder) / CASE_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def reusable(scene: Scene, model: str, folder: Path, root: Path = PROJECT_ROOT,
+             need_indicator: bool = False) -> tuple[dict[str, Any] | None, str]:
+    """``(record, "")`` when ``folder`` holds this very case finished, else ``(None, why)``.
+
+    Finished: a ``case.json`` that is not a failure, beside a result set whose identity is the
+    one the runner would record now (scene content, options, resolution, code).
+    """
+    rec = read_record(folder)
+    if rec is None:
+        return None, ""
+    if rec.get("status") == "failed":
+        return None, "it failed before (tried again)"
+    why = get_model(model).identity(scene, root).differences(stored_identity(folder))
+    if why:
+        return None, "; ".join(why)
+    if need_indicator and rec.get("indicator") is None and rec.get("status") == "done":
+        return None, "it has no error indicator (asked by check)"
+    return rec, ""
+
+
+def linear_indicator(scene: Scene) -> float | None:
+    """The beam's core-level error indicator of ``scene`` (relative, None if not known).
+
+    The relative change of the linear stiffness when every core level is raised by
+    :data:`LOOKAHEAD` (the saturation estimate the ``"auto"`` core uses,
+    :mod:`beam_element.core_levels`), on the small-displacement step.
+    """
+    level = scene.beam_model.core
+    if not isinstance(level, int):
+        return None
+    linear = dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
+                                                                     kind="linear"))
+    spec = get_model("beam")
+    lo = spec.solve(linear)
+    hi = spec.solve(with_options(linear, "beam", core=min(level + LOOKAHEAD, MAX_CORE_LEVEL)))
+    if not (lo.history and hi.history) or hi.final_load_factor == 0.0:
+        return None
+    err = abs(lo.final_load_factor - hi.final_load_factor) / abs(hi.final_load_factor)
+    return err if math.isfinite(err) else None
+
+
+def solve_case(task: dict[str, Any]) -> dict[str, Any]:
+    """Solve one case and write its record; returns the record (see the module docstring).
+
+    ``task`` holds ``index``, ``key``, ``values`` (axis values), ``scene``, ``model``,
+    ``folder``, ``indicator`` (compute the error indicator) and optionally ``root``.
+    """
+    scene: Scene = task["scene"]
+    model: str = task["model"]
+    folder = Path(task["folder"])
+    root = Path(task.get("root") or PROJECT_ROOT)
+    rec: dict[str, Any] = {"index": task["index"], "key": task["key"], "values": task["values"],
+                           "model": model, "host": os.uname().nodename, "pid": os.getpid()}
+    t0 = time.perf_counter()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / CASE_FILE).unlink(missing_ok=True)
+        run = obtain(scene, model, folder, reuse=False, root=root)
+        if run.solution is None:
+            rec.update(status="failed", reason=run.reason)
+        else:
+            rec.update(case_metrics(scene, run.solution))
+            rec["status"] = "done" if run.solution.converged else "stopped"
+            rec["reason"] = "" if run.solution.converged else rec["stop_reason"]
+            core = run.solution.extra.get("core")
+            est = core.get("estimated_error") if isinstance(core, dict) else None
+            rec["indicator"] = est
+            if est is None and task.get("indicator") and model == "beam":
+                rec["indicator"] = linear_indicator(scene)
+    except Exception as exc:  # noqa: BLE001 - a failing case is a record, never a stopped study
+        tb = traceback.extract_tb(exc.__traceback__)
+        where = f" ({Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
+        rec.update(status="failed", reason=f"{type(exc).__name__}: {exc}{where}")
+    rec["wall_seconds"] = round(time.perf_counter() - t0, 3)
+    try:
+        _write_json(folder / CASE_FILE, rec)
+    except OSError as exc:
+        rec.update(status="failed", reason=f"its record could not be written ({exc})")
+    return rec
