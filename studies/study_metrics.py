@@ -13,7 +13,8 @@ deflections are the scene's ``until`` probe (the first probe if it has none), in
   converged step), raw and averaged over 5 mm (:func:`comparisons.profiles.peak`, the window the
   comparisons use: the raw peak at a debond tip grows under mesh refinement, the average converges);
 - ``contact_length``: length of x (mm) where either face presses on the core (contact pressure
-  > 0) at the last profile, for the models that report it (the beam);
+  > 0) at the last profile, for the models that report it: the trapezoid of the contact flag
+  over the profile's samples (within one sample spacing);
 - ``steps``, ``converged``, ``stop_reason``, ``solve_seconds``.
 """
 
