@@ -14,17 +14,29 @@ import dataclasses
 import json
 import math
 import os
+import signal
+import threading
 import time
 import traceback
 from pathlib import Path
 from typing import Any
 
 from models import PROJECT_ROOT, get_model, obtain, stored_identity, with_options
+from sandwich.results import load_result
 from sandwich.scene import MAX_CORE_LEVEL, Scene
 from studies.study_metrics import case_metrics
 
 CASE_FILE = "case.json"
 LOOKAHEAD = 2  # the indicator compares the case's core level with this many levels more
+
+
+class CaseTimeout(KeyboardInterrupt):
+    """The study's wall-time cap of a case, raised at a converged step past it.
+
+    A ``KeyboardInterrupt``: the runner then writes every converged step so far (history only,
+    never reused) as it does for Ctrl-C; the cap is checked at each converged step, so a single
+    step that hangs is not stopped by it.
+    """
 
 
 def _write_json(path: Path, data: dict[str, Any]) -> None:
@@ -83,6 +95,40 @@ def linear_indicator(scene: Scene) -> float | None:
     return err if math.isfinite(err) else None
 
 
+_REAL_SIGNAL = signal.signal
+
+
+def _signal_on_main_thread_only(signum, handler):  # type: ignore[no-untyped-def]
+    """``signal.signal`` that leaves the handlers as they are when called off the main thread."""
+    if threading.current_thread() is threading.main_thread():
+        return _REAL_SIGNAL(signum, handler)
+    return signal.getsignal(signum)
+
+
+def _over_budget(scene: Scene, model: str, max_cells: object) -> str:
+    """Why a 2D case is not run (its mesh exceeds the study's ``max_cells``), or ``""``."""
+    if model != "2d" or not isinstance(max_cells, int):
+        return ""
+    from meshes import build_mesh
+
+    cells = len(build_mesh(scene).cells)
+    if cells > max_cells:
+        return (f"2D mesh at level {scene.reference2d.level} has {cells} cells, above the "
+                f"study's max_cells = {max_cells}")
+    return ""
+
+
+def prepare_2d() -> bool:
+    """Let the 2D model run on a worker thread of this process (a Dask worker's tasks do).
+
+    gmsh sets and restores a SIGINT handler at import, ``initialize`` and ``finalize``, which
+    Python allows only on the main thread: off it, the worker's ``signal.signal`` leaves the
+    handlers unchanged instead of raising (a worker's tasks are never interrupted by Ctrl-C).
+    """
+    signal.signal = _signal_on_main_thread_only
+    return True
+
+
 def solve_case(task: dict[str, Any]) -> dict[str, Any]:
     """Solve one case and write its record; returns the record (see the module docstring).
 
@@ -99,8 +145,38 @@ def solve_case(task: dict[str, Any]) -> dict[str, Any]:
     try:
         folder.mkdir(parents=True, exist_ok=True)
         (folder / CASE_FILE).unlink(missing_ok=True)
-        run = obtain(scene, model, folder, reuse=False, root=root)
-        if run.solution is None:
+        if model == "2d" and threading.current_thread() is not threading.main_thread():
+            prepare_2d()
+        skip = _over_budget(scene, model, task.get("max_cells"))
+        if skip:
+            rec.update(status="skipped", reason=skip)
+            rec["wall_seconds"] = round(time.perf_counter() - t0, 3)
+            _write_json(folder / CASE_FILE, rec)
+            return rec
+        cap = task.get("timeout")
+        steps = [0]
+
+        def watch(event: Any) -> None:
+            if event.phase != "step":
+                return
+            steps[0] += 1
+            if cap and time.perf_counter() - t0 > cap:
+                raise CaseTimeout(f"stopped by the study's wall-time cap of {cap:g} s after "
+                                  f"{steps[0]} converged steps")
+
+        try:
+            run = obtain(scene, model, folder, reuse=False, root=root, progress=watch)
+        except CaseTimeout as exc:
+            rec.update(status="timeout", reason=str(exc))
+            try:
+                rec.update({k: v for k, v in case_metrics(scene, load_result(folder)).items()
+                            if k not in ("converged", "stop_reason")})
+            except (OSError, ValueError, KeyError):
+                pass
+            run = None
+        if run is None:
+            pass
+        elif run.solution is None:
             rec.update(status="failed", reason=run.reason)
         else:
             rec.update(case_metrics(scene, run.solution))

@@ -34,7 +34,12 @@ def corners(study: Study) -> list[int]:
 
 
 def select_checks(study: Study, records: dict[int, dict[str, Any]], n: int) -> list[int]:
-    """The case indices to check with the 2D model (see the module docstring), at most ``n``."""
+    """The case indices to check with the 2D model (see the module docstring), at most ``n``.
+
+    ``check = "all"`` (``study.check_all``): every case, whatever the beam did.
+    """
+    if study.check_all:
+        return [c.index for c in study.cases]
     ok = {i for i, r in records.items() if r.get("status") in ("done", "stopped")}
 
     def indicator(i: int) -> float:

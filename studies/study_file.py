@@ -28,8 +28,8 @@ from sandwich.scene_checks import build_scene
 from studies.study_params import DERIVED, DERIVED_KEYS, PathError, base_value, resolve, set_path
 
 MODELS = ("beam", "2d")
-TOP_KEYS = ("name", "description", "scene", "model", "check", "axis", "beam_model",
-            "reference2d", "report")
+TOP_KEYS = ("name", "description", "scene", "model", "check", "timeout", "max_cells", "axis",
+            "beam_model", "reference2d", "report")
 AXIS_KEYS = ("name", "path", "derived", "values", "range", "logrange", "scale", "debond",
              "centre", "interfaces")
 REPORT_KEYS = ("quantity", "reference", "threshold")
@@ -90,6 +90,9 @@ class Study:
     report: Report
     cases: tuple[Case, ...]
     check_options: dict[str, Any] = field(default_factory=dict)  # [reference2d] of the checks
+    check_all: bool = False  # check = "all": every case, whatever the beam did
+    timeout: float | None = None  # wall-time cap of a case (s), checked at each converged step
+    max_cells: int | None = None  # 2D checks: a mesh above this many cells is not run
 
 
 def case_key(scene: Scene, model: str, options: dict[str, Any]) -> str:
@@ -367,9 +370,21 @@ def load_study(path: str | Path) -> Study:
         p.fail("model", f"{model!r} is not one of {', '.join(MODELS)}")
         model = "beam"
     check = data.get("check", 0)
-    if isinstance(check, bool) or not isinstance(check, int) or check < 0:
-        p.fail("check", f"expected a count of cases >= 0, got {check!r}")
+    check_all = check == "all"
+    if check_all:
+        check = MAX_CASES
+    elif isinstance(check, bool) or not isinstance(check, int) or check < 0:
+        p.fail("check", f"expected a count of cases >= 0 or \"all\", got {check!r}")
         check = 0
+    timeout = data.get("timeout")
+    if timeout is not None and (not _number(timeout) or timeout <= 0):
+        p.fail("timeout", f"expected a wall-time cap in seconds > 0, got {timeout!r}")
+        timeout = None
+    max_cells = data.get("max_cells")
+    if max_cells is not None and (isinstance(max_cells, bool) or not isinstance(max_cells, int)
+                                  or max_cells < 1):
+        p.fail("max_cells", f"expected a cell count >= 1, got {max_cells!r}")
+        max_cells = None
     if check and model != "beam":
         p.fail("check", "2D spot checks are of a beam study (model = \"beam\")")
     tables = {}
@@ -440,7 +455,9 @@ def load_study(path: str | Path) -> Study:
         raise StudyError(p.items)
     return Study(name=name, description=description, source=path, scene_path=scene_path,
                  model=model, check=check, axes=tuple(axes), report=report,
-                 cases=tuple(cases), check_options=dict(tables["reference2d"]))
+                 cases=tuple(cases), check_options=dict(tables["reference2d"]),
+                 check_all=check_all, timeout=None if timeout is None else float(timeout),
+                 max_cells=max_cells)
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -181,7 +181,8 @@ def run_cases(study: Study, out: Path, cases: list[Case] | None = None, *, model
         for case, folder in todo:
             task = {"index": case.index, "key": case.key, "values": case.values,
                     "scene": case.scene, "model": model, "folder": str(folder.resolve()),
-                    "indicator": indicator, "root": str(root)}
+                    "indicator": indicator, "root": str(root), "timeout": study.timeout,
+                    "max_cells": study.max_cells}
             fut = client.submit(solve_case, task, key=f"{study.name}-{kind}-{case.key}",
                                 pure=False, retries=0)
             futures[fut] = case

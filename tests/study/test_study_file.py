@@ -174,3 +174,23 @@ def _close(a, b):
     if isinstance(a, float):
         return math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-12)
     return a == b
+
+
+@pytest.mark.parametrize("sweep", ["stiffness", "thickness", "slenderness", "debond", "load"])
+def test_the_extremes_studies_hold_the_maps_sweeps_and_build_its_scenes(sweep):
+    """The shipped extremes-<sweep> study against the map's own typed transformations."""
+    from studies import extremes
+
+    study = load_study(ROOT / "studies" / "shipped" / f"extremes-{sweep}.toml")
+    assert study.check_all and study.timeout and study.max_cells
+    base = load_scene(FIG5)
+    want = {v: sc for sw, v, sc in extremes.cases(base, [sweep])}
+    assert len(study.cases) == len(want) == len(extremes.SWEEPS[sweep])
+    for case in study.cases:
+        (v,) = case.values.values()
+        v = v / base.length if sweep == "debond" else v
+        ref = want[next(x for x in want if math.isclose(x, v))]
+        for f in ("length", "top", "core", "bottom", "debonds", "supports", "loads", "probes"):
+            assert _close(getattr(case.scene, f), getattr(ref, f)), (sweep, v, f)
+        assert math.isclose(case.scene.analysis.until_value, ref.analysis.until_value)
+        assert case.scene.beam_model.core == 1 and case.scene.beam_model.elements == 240
