@@ -151,21 +151,27 @@ def plot(study: Study, table: list[dict[str, Any]], out: Path) -> list[Path]:
                    if r.get("checked_2d") and y is not None]
             if chk:
                 ax.plot(*zip(*chk, strict=True), "o", ms=11, mfc="none", mec="red", mew=1.5)
-            if show == "knockdown":
-                twod = [(x, r.get("2d_" + q), r) for x, r in zip(xs, rs, strict=True)
-                        if r.get("checked_2d")]
-                for x, v, r in twod:
-                    ref = _ref_value(study, table, r, q)
-                    if _num(v) is not None and ref:
-                        ax.plot([x], [float(v) / ref], "x", color="red", ms=8)
+            for x, y, r in zip(xs, ys, rs, strict=True):
+                if not r.get("checked_2d") or y is None:
+                    continue
+                e = _num(r.get(f"error_{q}"))
+                if e is not None:
+                    ax.annotate(f"{100 * e:+.0f}%", (x, y), xytext=(0, 9),
+                                textcoords="offset points", ha="center", fontsize=7,
+                                color="red")
+                v = _num(r.get("2d_" + q))
+                ref = _ref_value(study, table, r, q) if show == "knockdown" else 1.0
+                if v is not None and ref:  # the 2D knock-down needs the 2D reference too
+                    ax.plot([x], [v / ref], "x", color="red", ms=8)
         if study.report.threshold is not None and show == "knockdown":
             ax.axhline(study.report.threshold, color="grey", ls="--", lw=1)
         ax.set_xlabel(a.name)
         ax.set_ylabel(label)
         if len(groups) > 1 and len(groups) <= 12:
             ax.legend(fontsize=7)
-        ax.set_title(f"{study.name}: red circles = checked with the 2D model (x: 2D value)",
-                     fontsize=8)
+        ax.set_title(f"{study.name}: red circles = checked with the 2D model, beam-vs-2D error "
+                     f"of {q} (x: the 2D value, where the 2D model checked the reference too)",
+                     fontsize=7)
         fig.tight_layout()
         path = out / f"{study.name}-curve.png"
         fig.savefig(path, dpi=120)
@@ -219,12 +225,12 @@ def plot(study: Study, table: list[dict[str, Any]], out: Path) -> list[Path]:
 
 def _ref_value(study: Study, table: list[dict[str, Any]], row: dict[str, Any],
                q: str) -> float | None:
-    """The 2D value of ``q`` at the row's reference case, else the beam's there."""
+    """The 2D value of ``q`` at the row's reference case (None if the 2D did not check it)."""
     want = {**{a.name: row[a.name] for a in study.axes}, **study.report.reference}
     for r in table:
         if all(r[k] == v or (isinstance(v, float) and isinstance(r[k], float)
                              and math.isclose(r[k], v)) for k, v in want.items()):
-            return _num(r.get("2d_" + q)) or _num(r.get(q))
+            return _num(r.get("2d_" + q))
     return None
 
 
