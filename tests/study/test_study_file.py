@@ -194,3 +194,13 @@ def test_the_extremes_studies_hold_the_maps_sweeps_and_build_its_scenes(sweep):
             assert _close(getattr(case.scene, f), getattr(ref, f)), (sweep, v, f)
         assert math.isclose(case.scene.analysis.until_value, ref.analysis.until_value)
         assert case.scene.beam_model.core == 1 and case.scene.beam_model.elements == 240
+
+
+def test_cli_refuses_bad_workers_and_an_output_path_that_is_a_file(tmp_path, capsys):
+    tiny = str(HERE / "tiny.toml")
+    assert main(["study", tiny, "--workers", "0", "--out", str(tmp_path / "o")]) == 2
+    assert "--workers: must be between 1 and" in capsys.readouterr().err
+    (tmp_path / "file").write_text("x")
+    assert main(["study", tiny, "--out", str(tmp_path / "file")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "file" in err
