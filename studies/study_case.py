@@ -154,7 +154,9 @@ def solve_case(task: dict[str, Any]) -> dict[str, Any]:
     """Solve one case and write its record; returns the record (see the module docstring).
 
     ``task`` holds ``index``, ``key``, ``values`` (axis values), ``scene``, ``model``,
-    ``folder``, ``indicator`` (compute the error indicator) and optionally ``root``.
+    ``folder``, ``indicator`` (compute the error indicator), ``fields`` (keep the field frames,
+    else the result set is history, profiles and summary) and optionally ``root``,
+    ``timeout`` and ``max_cells``.
     """
     scene: Scene = task["scene"]
     model: str = task["model"]
@@ -185,8 +187,17 @@ def solve_case(task: dict[str, Any]) -> dict[str, Any]:
                 raise CaseTimeout(f"stopped by the study's wall-time cap of {cap:g} s after "
                                   f"{steps[0]} converged steps")
 
+        spec = get_model(model)
+
+        def solver(sc: Scene, progress: Any = None) -> Any:
+            sol = spec.solve(sc, progress)
+            if not task.get("fields"):  # a study keeps no field frames unless asked
+                sol.fields = []
+            return sol
+
         try:
-            run = obtain(scene, model, folder, reuse=False, root=root, progress=watch)
+            run = obtain(scene, model, folder, reuse=False, root=root, progress=watch,
+                         solver=solver)
         except CaseTimeout as exc:
             rec.update(status="timeout", reason=str(exc))
             try:

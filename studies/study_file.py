@@ -28,8 +28,8 @@ from sandwich.scene_checks import build_scene
 from studies.study_params import DERIVED, DERIVED_KEYS, PathError, base_value, resolve, set_path
 
 MODELS = ("beam", "2d")
-TOP_KEYS = ("name", "description", "scene", "model", "check", "timeout", "max_cells", "axis",
-            "beam_model", "reference2d", "report")
+TOP_KEYS = ("name", "description", "scene", "model", "check", "timeout", "max_cells", "fields",
+            "axis", "beam_model", "reference2d", "report")
 AXIS_KEYS = ("name", "path", "derived", "values", "range", "logrange", "scale", "debond",
              "centre", "interfaces")
 REPORT_KEYS = ("quantity", "reference", "threshold")
@@ -93,6 +93,7 @@ class Study:
     check_all: bool = False  # check = "all": every case, whatever the beam did
     timeout: float | None = None  # wall-time cap of a case (s), checked at each converged step
     max_cells: int | None = None  # 2D checks: a mesh above this many cells is not run
+    fields: bool = False  # keep each case's field frames (fields.pvd; ~2 MB a beam case)
 
 
 def case_key(scene: Scene, model: str, options: dict[str, Any]) -> str:
@@ -380,6 +381,10 @@ def load_study(path: str | Path) -> Study:
     if timeout is not None and (not _number(timeout) or timeout <= 0):
         p.fail("timeout", f"expected a wall-time cap in seconds > 0, got {timeout!r}")
         timeout = None
+    fields = data.get("fields", False)
+    if not isinstance(fields, bool):
+        p.fail("fields", "expected true or false")
+        fields = False
     max_cells = data.get("max_cells")
     if max_cells is not None and (isinstance(max_cells, bool) or not isinstance(max_cells, int)
                                   or max_cells < 1):
@@ -457,7 +462,7 @@ def load_study(path: str | Path) -> Study:
                  model=model, check=check, axes=tuple(axes), report=report,
                  cases=tuple(cases), check_options=dict(tables["reference2d"]),
                  check_all=check_all, timeout=None if timeout is None else float(timeout),
-                 max_cells=max_cells)
+                 max_cells=max_cells, fields=fields)
 
 
 def _same(a: Any, b: Any) -> bool:

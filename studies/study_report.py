@@ -112,8 +112,11 @@ def crossings(study: Study, table: list[dict[str, Any]]) -> list[dict[str, Any]]
                     at = x0 + (k0 - thr) / (k0 - k) * (x1 - x0) if k0 != k else x1
                 break
             prev = r
+        below = r if at is not None else None
         out.append({**{a.name: v for a, v in zip(others, key, strict=True)}, "at": at,
-                    "after": None if prev is None else prev[first.name]})
+                    "after": None if prev is None else prev[first.name],
+                    "kind": (below.get("first_limit_kind") or "no limit point before the "
+                             "target") if below is not None else ""})
     return out
 
 
@@ -269,12 +272,13 @@ def summary(study: Study, table: list[dict[str, Any]], run_lines: list[str],
                "", f"Along {study.axes[0].name} (linear interpolation between the bracketing "
                "cases):", ""]
         others = [a.name for a in study.axes[1:]]
-        md.append("| " + " | ".join([*others, study.axes[0].name + " at the threshold"]) + " |")
-        md.append("|" + "---|" * (len(others) + 1))
+        md.append("| " + " | ".join([*others, study.axes[0].name + " at the threshold",
+                                      f"{q} of the first case below it"]) + " |")
+        md.append("|" + "---|" * (len(others) + 2))
         for c in cross:
             at = "not within the axis" if c["at"] is None else f"{c['at']:.3g}"
             md.append("| " + " | ".join([*(f"{c[o]:g}" if isinstance(c[o], float) else str(c[o])
-                                           for o in others), at]) + " |")
+                                           for o in others), at, c["kind"]]) + " |")
         md.append("")
     if checks:
         md += ["## 2D spot checks", "",

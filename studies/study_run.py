@@ -182,7 +182,7 @@ def run_cases(study: Study, out: Path, cases: list[Case] | None = None, *, model
             task = {"index": case.index, "key": case.key, "values": case.values,
                     "scene": case.scene, "model": model, "folder": str(folder.resolve()),
                     "indicator": indicator, "root": str(root), "timeout": study.timeout,
-                    "max_cells": study.max_cells}
+                    "max_cells": study.max_cells, "fields": study.fields}
             fut = client.submit(solve_case, task, key=f"{study.name}-{kind}-{case.key}",
                                 pure=False, retries=0)
             futures[fut] = case
