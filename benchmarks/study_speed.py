@@ -27,6 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from studies.study import run_study  # noqa: E402
 from studies.study_file import load_study  # noqa: E402
+from studies.study_report import crossings  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "studies"
 
@@ -48,6 +49,7 @@ def main(argv: list[str] | None = None) -> int:
                                 cases=study.cases[: args.limit] if args.limit else study.cases)
     n = len(study.cases)
     rows = []
+    answers: list[list[dict]] = []
 
     def timed(label: str, **engine) -> None:
         with tempfile.TemporaryDirectory(prefix="study-speed-") as tmp:
@@ -72,6 +74,7 @@ def main(argv: list[str] | None = None) -> int:
                "rerun_s": round(resume, 1), "rerun_reused": again.cases.reused,
                "load_before": before, "load_after": after}
         rows.append(row)
+        answers.append(crossings(study, res.rows))
         print(row, flush=True)
 
     timed("1 local worker (engine's LocalCluster)", workers=1)
@@ -102,6 +105,15 @@ def main(argv: list[str] | None = None) -> int:
                   f"{r['cases_per_min']} | {r['mean_case_s']} | {r['mean_solve_s']} | "
                   f"{r['sum_case_s']} | {r['rerun_s']} | {r['rerun_reused']} | "
                   f"{r['load_before']} | {r['load_after']} |")
+    if answers and answers[0]:
+        others = [a.name for a in study.axes[1:]]
+        md += ["", f"The study's threshold answer from each timed run ({study.axes[0].name} where "
+               f"the knock-down falls to {study.report.threshold:g}, per "
+               f"{', '.join(others)}):", ""]
+        for label, ans in zip((r["configuration"] for r in rows), answers, strict=True):
+            md.append(f"- {label}: " + ", ".join(
+                f"{'/'.join(f'{c[o]:g}' for o in others)}: "
+                + ("—" if c["at"] is None else f"{c['at']:.3g}") for c in ans))
     (args.out / "study_speed.md").write_text("\n".join(md) + "\n")
     return 0
 
