@@ -49,8 +49,13 @@ PENALTY_GROWTH = 2.0
 # "auto" core levels along a path: the last converged state says where the core wants more
 # levels (beam_element.core_levels.state_shares); the path is rerun with those raised and the
 # change of the end load is the estimate; reruns continue while it exceeds the tolerance, at most
-# CORE_RECHECKS times.
+# CORE_RECHECKS times. A rerun may take at most RERUN_STEP_FACTOR times the steps of the pass it
+# checks (at least RERUN_MIN_STEPS): a raised model that needs far more steps has met a path the
+# checked pass did not see (default scene, level 4 over the debond: a limit point at −6 mm the
+# 2D model does not have, 240+ steps), and the kept answer is then the checked pass, said so.
 CORE_RECHECKS = 3
+RERUN_STEP_FACTOR = 3
+RERUN_MIN_STEPS = 30
 
 
 @dataclass(frozen=True)
@@ -124,21 +129,29 @@ def linear_solution(model: BeamModel, load_factor: float) -> tuple[np.ndarray, i
     )
 
 
+def _toward_target(model: BeamModel, probe: str, target: float) -> tuple[float, np.ndarray, int]:
+    """The sign of λ whose linear solution moves ``probe`` towards ``target``.
+
+    Returns (sign, the linear solution at λ = sign, active-set passes). Unilateral contact
+    makes the response homogeneous for λ > 0 only, so both signs are solved if need be.
+    """
+    row = model.probe_vector(probe)
+    for sign in (1.0, -1.0):
+        u1, passes = linear_solution(model, sign)
+        if float(row @ u1) * target > 0:
+            return sign, u1, passes
+    raise ValueError(f"probe {probe!r} does not move under the scene's loads")
+
+
 def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState], str]:
     a = scene.analysis
     names = list(model.probe_rows)
     probe = {n: model.probe_vector(n) for n in names}
     zero = ConvergedState(0, 0.0, np.zeros(model.size), 0, {n: 0.0 for n in names})
     if a.until_probe is not None:
-        for sign in (1.0, -1.0):  # unilateral contact: the response is homogeneous for λ > 0
-            u1, passes = linear_solution(model, sign)
-            value = float(probe[a.until_probe] @ u1)
-            if value * a.until_value > 0:
-                λ = sign * a.until_value / value
-                u = u1 * (λ / sign)
-                break
-        else:
-            raise ValueError(f"probe {a.until_probe!r} does not move under the scene's loads")
+        sign, u1, passes = _toward_target(model, a.until_probe, a.until_value)
+        λ = sign * a.until_value / float(probe[a.until_probe] @ u1)
+        u = u1 * (λ / sign)
         message = f"linear solution scaled to {a.until_probe} = {a.until_value:g}"
     else:
         λ = a.until_load_factor if a.until_load_factor is not None else 1.0
@@ -205,11 +218,26 @@ def run(
         converged = True
     else:
         previous: ConvergedState | None = None
+        kept: tuple | None = None  # the last pass that reached the target, and its levels
+        stopped_rerun = ""
         for recheck in range(CORE_RECHECKS + 1):
-            model, states, message, converged, limit_points, raised = _follow_penalised(
-                scene, elements, {**options, "core_level": choice.levels}, progress)
+            budget = None if kept is None else min(
+                int(a.max_steps), max(RERUN_MIN_STEPS, RERUN_STEP_FACTOR * (len(kept[0][1]) - 1)))
+            result = _follow_penalised(scene, elements, {**options, "core_level": choice.levels},
+                                       progress, max_steps=budget)
+            model, states, message, converged, limit_points, raised = result
             last = states[-1]
             if choice.how != "auto" or last.load_factor == 0.0:
+                break
+            if not converged and kept is not None:
+                # The raised path stopped short of the target: keep the pass it was checking.
+                choice.passes.append({"stage": f"path step {last.step}",
+                                      "elements_per_level": level_counts(choice.levels),
+                                      "load_factor": last.load_factor, "reached": False,
+                                      "estimate": None, "stopped": message})
+                stopped_rerun = message
+                (model, states, message, converged, limit_points, raised), choice.levels, \
+                    choice.estimate = kept
                 break
             if previous is not None:  # the change the last raise made is the estimate
                 choice.estimate = (abs(last.load_factor - previous.load_factor)
@@ -223,6 +251,7 @@ def run(
                     choice.estimate is not None and previous is not None
                     and choice.estimate <= tol):
                 break
+            kept = (result, choice.levels.copy(), choice.estimate)
             up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
                              **{**options, "core_level": lookahead_levels(choice.levels)})
             shares = state_shares(model, last.u, last.load_factor, up)
@@ -238,6 +267,9 @@ def run(
             previous = last
             if progress is not None:
                 progress(CoreRecheck(level_counts(choice.levels)))
+        if stopped_rerun:
+            message += (f"; WARNING: the rerun with raised core levels stopped ({stopped_rerun}); "
+                        "this is the pass it was checking")
         if choice.how == "auto" and not converged and np.any(choice.levels > 1):
             # The path at the chosen levels stopped short: the paper's element is the fallback
             # (extremes map: thin faces, L/h = 5 and load x2 reach their target only at level 1).
@@ -257,13 +289,14 @@ def run(
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
-        if choice.how == "auto" and converged and np.any(choice.levels > 1) and (
-                choice.estimate is None or choice.estimate > float(bm.tolerance)):
-            said = ("could not be estimated" if choice.estimate is None else
-                    f"{100 * choice.estimate:.2g} % exceeds the tolerance "
-                    f"{100 * float(bm.tolerance):.2g} %")
-            message += (f"; WARNING: the core's estimated error {said} (max_core_level "
-                        f"{bm.max_core_level}, {CORE_RECHECKS} reruns)")
+    if choice.how == "auto" and converged and np.any(choice.levels > 1) and (
+            choice.estimate is None or choice.estimate > float(bm.tolerance)):
+        said = ("could not be estimated" if choice.estimate is None else
+                f"{100 * choice.estimate:.2g} % exceeds the tolerance "
+                f"{100 * float(bm.tolerance):.2g} %")
+        reruns = f", {_path_passes(choice) - 1} rerun(s) of the path" if nonlinear else ""
+        message += (f"; WARNING: the core's estimated error {said} (max_core_level "
+                    f"{bm.max_core_level}{reruns})")
     solution = _solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(_growth_summary(scene, solution))
@@ -277,6 +310,11 @@ def run(
     }
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _path_passes(choice: LevelChoice) -> int:
+    """How many times auto followed the path (its passes after the linear-step ones)."""
+    return sum(p["stage"].startswith("path step") for p in choice.passes)
 
 
 def _growth_summary(scene: object, solution: Solution) -> dict[str, object]:
@@ -317,7 +355,7 @@ def choose_core_levels(scene: object, elements: int | None, options: dict) -> Le
     sign = _load_sign(build(floor), scene)
     choice = auto_levels(build, lambda m: linear_solution(m, sign)[0], mesh.n_elements,
                          float(getattr(bm, "tolerance", 0.01)),
-                         int(getattr(bm, "max_core_level", 4)), probe=scene.analysis.until_probe)
+                         int(getattr(bm, "max_core_level", 3)), probe=scene.analysis.until_probe)
     choice.levels = np.maximum(choice.levels, floor)
     return choice
 
@@ -338,9 +376,10 @@ def _load_sign(model: BeamModel, scene: object) -> float:
     """Sign of the load factor the analysis heads for (unilateral contact is not odd in λ)."""
     a = scene.analysis
     if a.until_probe is not None:
-        u, _ = linear_solution(model, 1.0)
-        value = float(model.probe_vector(a.until_probe) @ u)
-        return 1.0 if value * a.until_value >= 0 else -1.0
+        try:
+            return _toward_target(model, a.until_probe, a.until_value)[0]
+        except ValueError:  # the path follower says so in its own words
+            return 1.0
     if a.until_load_factor is not None and a.until_load_factor < 0:
         return -1.0
     return 1.0
@@ -363,13 +402,16 @@ class CoreRecheck:
 
 def _follow_penalised(
     scene: object, elements: int | None, options: dict,
-    progress: Callable[[object], None] | None,
+    progress: Callable[[object], None] | None, max_steps: int | None = None,
 ) -> tuple[BeamModel, list[ConvergedState], str, bool, list[LimitPoint], list[float]]:
-    """Follow the path; rerun with a stiffer penalty while converged states penetrate too deep."""
+    """Follow the path; rerun with a stiffer penalty while converged states penetrate too deep.
+
+    ``max_steps`` (default the scene's) caps the steps of each attempt.
+    """
     raised: list[float] = []
     model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
     while True:
-        states, message, converged, limit_points = _follow(model, scene, progress)
+        states, message, converged, limit_points = _follow(model, scene, progress, max_steps)
         pen, bound = _max_penetration(model, states), model.penetration_bound()
         if pen <= bound or len(raised) == PENALTY_RESTARTS:
             return model, states, message, converged, limit_points, raised
@@ -380,14 +422,16 @@ def _follow_penalised(
 
 
 def _follow(
-    model: BeamModel, scene: object, progress: Callable[[object], None] | None
+    model: BeamModel, scene: object, progress: Callable[[object], None] | None,
+    max_steps: int | None = None,
 ) -> tuple[list[ConvergedState], str, bool, list[LimitPoint]]:
     """Follow the nonlinear path of ``scene`` on ``model``: states, message, reached, limits."""
     from sandwich.solver.path import PathOptions, follow_path
 
     a = scene.analysis
+    caps = {} if max_steps is None else {"max_steps": int(max_steps)}
     options = PathOptions.from_analysis(a, min_increment=_min_increment(model, a),
-                                        desired_iterations=DESIRED_ITERATIONS)
+                                        desired_iterations=DESIRED_ITERATIONS, **caps)
     result = follow_path(model, options, list(model.probe_rows), progress)
     states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
               for s in result.states]

@@ -12,7 +12,9 @@ Cases (scene, target, 2D reference):
 - ``fig4``: fig. 4 to w_top_mid = −12 mm; reference the 2D ``medium`` run of
   ``benchmarks/results/comparisons/tradeoff.csv`` (its ``fine`` run stopped before −12 mm);
 - ``fig5``: fig. 5 to w_top_mid = −15 mm; reference the 2D ``fine`` run of tradeoff.csv;
-- ``c3``: the c3 cantilever to −40 mm; reference the 2D ``medium`` run, solved here.
+- ``c3``: the c3 cantilever to −40 mm; reference the 2D ``medium`` run, solved here;
+- ``demo``: ``scenes/default.toml`` (fig. 5 to −8 mm, the ``make demo`` scene); reference the 2D
+  ``fine`` run, solved here.
 
 Variants: ``L<k>`` every element at level k (``P<k>``: the polynomial family), ``auto`` the
 scene default (error indicator against ``[beam_model] tolerance``). Elements: the scene's
@@ -43,16 +45,20 @@ CASES = {
     "fig4": ("paper-fig4-bonded-3pb.toml", -12.0, "nonlinear"),
     "fig5": ("paper-fig5-top-debond-40-load-top.toml", -15.0, "nonlinear"),
     "c3": ("paper-fig7-cantilever-c3.toml", -40.0, "nonlinear"),
+    "demo": ("default.toml", -8.0, "nonlinear"),
 }
+REFERENCE_LEVEL = {"bend": "fine", "c3": "medium", "demo": "fine"}
 FIELDS = ["case", "variant", "elements", "dofs", "levels", "estimate", "lambda_end", "reached",
-          "steps", "iterations", "seconds", "load"]
+          "steps", "iterations", "seconds", "load", "w_end", "max_steps"]
 
 
-def case_scene(case: str):
+def case_scene(case: str, max_steps: int | None = None):
     """The case's scene with its target (and linear analysis for ``bend``)."""
     name, until, kind = CASES[case]
     scene = load_scene(ROOT / "scenes" / name)
     a = dataclasses.replace(scene.analysis, kind=kind, until_value=until)
+    if max_steps is not None:
+        a = dataclasses.replace(a, max_steps=max_steps)
     return dataclasses.replace(scene, analysis=a)
 
 
@@ -73,10 +79,10 @@ def reference(case: str) -> tuple[float, str]:
 
 
 def solve_reference(case: str) -> None:
-    """Solve the 2D model on the case and cache its end load (fine for bend, medium for c3)."""
+    """Solve the 2D model on the case and cache its end load (level: REFERENCE_LEVEL)."""
     from reference2d import solve as solve2d
 
-    level = "fine" if case == "bend" else "medium"
+    level = REFERENCE_LEVEL[case]
     t = time.perf_counter()
     sol = solve2d(case_scene(case), level=level)
     path = OUT / "core_levels_2d.json"
@@ -88,8 +94,8 @@ def solve_reference(case: str) -> None:
     print(case, cached[case], flush=True)
 
 
-def one(case: str, variant: str, elements: int | None) -> dict:
-    scene = case_scene(case)
+def one(case: str, variant: str, elements: int | None, max_steps: int | None = None) -> dict:
+    scene = case_scene(case, max_steps)
     opts: dict = {}
     if variant != "auto":
         opts = {"core_level": int(variant[1:]),
@@ -109,7 +115,9 @@ def one(case: str, variant: str, elements: int | None) -> dict:
                           else f"{core['estimated_error']:.4g}"),
                 lambda_end=f"{s.history[-1].load_factor:.6g}", reached=s.converged,
                 steps=len(s.history), iterations=s.extra["total_newton_iterations"],
-                seconds=f"{seconds:.2f}", load=f"{load:.2f}")
+                seconds=f"{seconds:.2f}", load=f"{load:.2f}",
+                w_end=f"{s.history[-1].probes[scene.analysis.until_probe]:.4g}",
+                max_steps=scene.analysis.max_steps)
 
 
 def report() -> None:
@@ -139,9 +147,15 @@ def report() -> None:
             if r["case"] != case:
                 continue
             err = float(r["lambda_end"]) / ref - 1
+            reached = r["reached"] == "True"
+            said = (f"{100 * err:+.2f} %" if reached else
+                    f"— (stopped at w = {r.get('w_end') or '?'} mm, max_steps "
+                    f"{r.get('max_steps') or '?'})")
             lines.append(f"| {r['variant']} | {r['elements']} | {r['dofs']} | {r['levels']} | "
-                         f"{r['estimate']} | {r['lambda_end']} | {100 * err:+.2f} % | "
+                         f"{r['estimate']} | {r['lambda_end']} | {said} | "
                          f"{r['reached']} | {r['steps']} | {r['seconds']} | {r['load']} |")
+            if not reached:
+                continue
             ax.loglog(float(r["seconds"]), abs(err) + 1e-5,
                       "o" if r["variant"] != "auto" else "*", ms=10 if r["variant"] == "auto"
                       else 6)
@@ -160,6 +174,7 @@ def main() -> None:
     p.add_argument("--case", choices=sorted(CASES), default="fig5")
     p.add_argument("--variants", nargs="*", default=["L1", "L2", "L3", "L4", "auto"])
     p.add_argument("--elements", type=int, default=None)
+    p.add_argument("--max-steps", type=int, default=None, help="cap the path's steps")
     p.add_argument("--reference2d", nargs="*", choices=sorted(CASES))
     p.add_argument("--report", action="store_true")
     a = p.parse_args()
@@ -173,7 +188,7 @@ def main() -> None:
         return
     path = OUT / "core_levels.csv"
     for v in a.variants:
-        row = one(a.case, v, a.elements)
+        row = one(a.case, v, a.elements, a.max_steps)
         new = not path.exists()
         with open(path, "a", newline="") as f:
             w = csv.DictWriter(f, FIELDS)

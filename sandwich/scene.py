@@ -187,7 +187,7 @@ class BeamModelOptions:
     core: int | str = "auto"  # core level 1 (the paper's) .. MAX_CORE_LEVEL, or "auto"
     core_basis: str = "sublayers"  # "sublayers" (graded C1 cubic sublayers) | "polynomial"
     tolerance: float = 0.01  # "auto": target relative error of the core's through-thickness field
-    max_core_level: int = 4  # "auto": highest level it may choose
+    max_core_level: int = 3  # "auto": highest level it may choose (docs/beam_element.md)
     core_zones: tuple[CoreZone, ...] = ()  # explicit levels over stretches of x
 
 

@@ -13,10 +13,13 @@ every resolution; wall times are measured here. The error of every run is taken 
 Writes ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` (error vs time, Pareto fronts)
 into ``benchmarks/results/comparisons/``.
 
-Beam variants: ``paper`` (the paper's element) and ``averaged`` (``face_membrane = "averaged"``,
-not the paper's, see docs/beam_vs_2d.md). ``--until NAME=VALUE`` ends a scene's path earlier (the
-fig4 2D core crushes at w ≈ −13 mm, so its path is compared to −12 mm). Wall and CPU seconds are
-both recorded: on a shared machine the CPU time is the steadier of the two.
+Beam variants: ``paper`` (the paper's element: core level 1), ``averaged`` (core level 1 with
+``face_membrane = "averaged"``, not the paper's, see docs/beam_vs_2d.md), ``L2``…``L6`` (every
+element at that core level, docs/beam_element.md "Core levels") and ``auto`` (``core = "auto"``,
+the scene default: levels from the error indicator, the path rerun to check them).
+``--until NAME=VALUE`` ends a scene's path earlier (the fig4 2D core crushes at w ≈ −13 mm, so
+its path is compared to −12 mm). Wall and CPU seconds are both recorded: on a shared machine
+the CPU time is the steadier of the two.
 
 Usage: ``python benchmarks/tradeoff.py [--elements 15 30 60 120] [--levels coarse medium fine]
 [--refine 0 1] [--scenes paper-fig4-bonded-3pb ...] [--variants paper averaged]
@@ -68,10 +71,17 @@ class Run:
     cpu_seconds: float = math.nan
 
 
+VARIANTS = ("paper", "averaged", "L2", "L3", "L4", "L5", "L6", "auto")
+
+
 def with_beam_elements(scene: Scene, n: int, variant: str = "paper") -> Scene:
-    """``scene`` with ``n`` beam elements and face membrane ``variant``."""
+    """``scene`` with ``n`` beam elements and the beam ``variant`` (see :data:`VARIANTS`)."""
+    if variant in ("paper", "averaged"):
+        core, membrane = 1, variant
+    else:
+        core, membrane = ("auto" if variant == "auto" else int(variant[1:])), "paper"
     return dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, elements=n, face_membrane=variant))
+        scene.beam_model, elements=n, face_membrane=membrane, core=core, core_zones=()))
 
 
 def with_until(scene: Scene, value: float) -> Scene:
@@ -92,7 +102,8 @@ def timed(label: str, scene: Scene, model: str, solve: Callable[[], Solution]) -
 
 
 def measure(scene: Scene, beam_solve, ref_solve, elements, levels, refines,
-            variants: tuple[str, ...] = ("paper",)) -> list[Run]:
+            variants: tuple[str, ...] = ("paper",),
+            variant_elements: dict[str, list[int]] | None = None) -> list[Run]:
     """Run every resolution of both models on ``scene``; errors against the finest 2D run."""
     runs = []
     for level in levels:
@@ -101,7 +112,7 @@ def measure(scene: Scene, beam_solve, ref_solve, elements, levels, refines,
             runs.append(timed(f"{level}+{refine}", scene, "2d",
                               lambda: ref_solve(scene, level=level, refine=refine)))  # noqa: B023
     for variant in variants:
-        for n in elements:
+        for n in (variant_elements or {}).get(variant, elements):
             print(f"{scene.name}: beam elements={n} {variant}", flush=True)
             sc = with_beam_elements(scene, n, variant)
             label = str(n) if variant == "paper" else f"{n} {variant}"
@@ -205,11 +216,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium", "fine"])
     ap.add_argument("--refine", nargs="+", type=int, default=[0])
     ap.add_argument("--variants", nargs="+", default=["paper", "averaged"],
-                    choices=["paper", "averaged"])
+                    choices=list(VARIANTS))
+    ap.add_argument("--variant-elements", nargs="+", default=[], metavar="VARIANT=N,N",
+                    help="element counts of one variant (default: --elements)")
     ap.add_argument("--until", nargs="+", default=["paper-fig4-bonded-3pb=-12"],
                     metavar="SCENE=VALUE", help="end a scene's path at this probe value")
     ap.add_argument("--out", type=Path, default=OUT)
     args = ap.parse_args(argv)
+    per_variant = {}
+    for item in args.variant_elements:
+        name, _, counts = item.partition("=")
+        try:
+            per_variant[name] = [int(c) for c in counts.split(",")]
+        except ValueError:
+            ap.error(f"--variant-elements {item!r}: expected VARIANT=N,N,...")
+        if name not in VARIANTS:
+            ap.error(f"--variant-elements {item!r}: unknown variant {name!r}")
     until = {}
     for item in args.until:
         name, _, value = item.partition("=")
@@ -230,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
             scene = with_until(scene, until[name])
         load = os.getloadavg()[0]
         rs = measure(scene, beam_solve, ref_solve, args.elements, args.levels,
-                     args.refine, tuple(args.variants))
+                     args.refine, tuple(args.variants), per_variant)
         runs += rs
         lines.append(headline(rs, name) + f" [path to {scene.analysis.until_probe} = "
                      f"{scene.analysis.until_value:g}; load average {load:.2f} at start, "

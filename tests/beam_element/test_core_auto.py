@@ -8,6 +8,7 @@ and the scene's mirror symmetry.
 from __future__ import annotations
 
 import dataclasses
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ import pytest
 from beam_scenes import sandwich_scene
 
 from beam_element import run
+from beam_element.core_levels import level_counts
 from beam_element.model import build_model
 from beam_element.solve import linear_solution
 from sandwich.scene import Analysis, CoreZone
@@ -30,9 +32,10 @@ def _stiffness(model) -> float:
 
 @pytest.mark.parametrize("tolerance", [0.01, 0.002])
 def test_auto_estimate_matches_the_true_error_on_the_linear_bend(tolerance):
+    """Levels up to 4 available (the default cap, 3, cannot reach 0.2 % at 60 elements)."""
     scene = sandwich_scene(elements=60, core_level="auto")
     scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, tolerance=tolerance))
+        scene.beam_model, tolerance=tolerance, max_core_level=4))
     r = run(scene)
     core = r.solution.extra["core"]
     assert core["how"] == "auto"
@@ -45,6 +48,19 @@ def test_auto_estimate_matches_the_true_error_on_the_linear_bend(tolerance):
     assert 0.3 * true <= core["estimated_error"] <= 3 * true + 1e-4, (true, core)
     # and the paper's element alone is off by more than the tolerance (auto had work to do)
     assert abs(_stiffness(build_model(scene, core_level=1)) / k_ref - 1) > 2 * tolerance
+
+
+def test_auto_says_when_its_level_cap_stops_it_short_of_the_tolerance():
+    """The same bend at 0.2 % with the default cap (level 3): the estimate stays above the
+    tolerance and the message says so (no silent miss)."""
+    scene = sandwich_scene(elements=60, core_level="auto")
+    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, tolerance=0.002))
+    r = run(scene)
+    core = r.solution.extra["core"]
+    assert r.model.element_levels.max() == 3
+    assert core["estimated_error"] > 0.002
+    assert "WARNING: the core's estimated error" in r.solution.message
 
 
 def test_auto_levels_are_mirror_symmetric_on_a_symmetric_scene():
@@ -77,13 +93,36 @@ def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
         kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
         max_steps=200))
     scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, tolerance=0.003))
+        scene.beam_model, tolerance=0.003, max_core_level=4))
     r = run(scene)
     core = r.solution.extra["core"]
     stages = [p["stage"] for p in core["passes"]]
-    assert any(s.startswith("path step") for s in stages), stages
+    assert sum(s.startswith("path step") for s in stages) >= 2, stages  # rerun at least once
     assert r.solution.converged
     assert core["estimated_error"] <= 0.003 or "WARNING" in r.solution.message
+
+
+def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
+    """The rerun's step budget (a multiple of the checked pass's steps) cut to 2 steps: the
+    raised path cannot reach −6 mm, so the answer is the first path pass (its levels, its end
+    load) with a WARNING, and the stopped rerun is listed in the passes."""
+    solve = sys.modules["beam_element.solve"]  # the module (the package exports a function)
+    monkeypatch.setattr(solve, "RERUN_STEP_FACTOR", 0)
+    monkeypatch.setattr(solve, "RERUN_MIN_STEPS", 2)
+    scene = sandwich_scene(elements=40, core_level="auto", analysis=Analysis(
+        kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
+        max_steps=200))
+    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, tolerance=0.003, max_core_level=4))
+    r = run(scene)
+    sol, core = r.solution, r.solution.extra["core"]
+    paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
+    first, rerun = paths[0], paths[-1]
+    assert sol.converged and "rerun with raised core levels stopped" in sol.message
+    assert rerun["reached"] is False and "max_steps = 2" in rerun["stopped"]
+    assert rerun["elements_per_level"] != first["elements_per_level"]
+    assert level_counts(r.model.element_levels) == first["elements_per_level"]
+    assert sol.final_load_factor == first["load_factor"]
 
 
 @pytest.mark.heavy

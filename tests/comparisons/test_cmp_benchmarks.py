@@ -105,3 +105,12 @@ def test_extremes_agreement_over_the_common_range_when_a_model_stops_early(scene
     assert a["end_error"] == pytest.approx(0.05, rel=1e-6)
     assert a["load_l2_lin"] == pytest.approx(0.05, rel=1e-3)
     assert "beam stopped early" in a["agree_note"] and "50 %" in a["agree_note"]
+
+
+def test_tradeoff_variants_set_the_core_level(scene):
+    """``paper``/``averaged`` are the paper's core (level 1), ``L<k>`` level k, ``auto`` auto."""
+    cases = {"paper": (1, "paper"), "averaged": (1, "averaged"), "L3": (3, "paper"),
+             "auto": ("auto", "paper")}
+    for variant, (core, membrane) in cases.items():
+        bm = tradeoff.with_beam_elements(scene, 30, variant).beam_model
+        assert (bm.core, bm.face_membrane, bm.elements) == (core, membrane, 30), variant
