@@ -23,6 +23,11 @@ The tangent is either written as blocks ``(E, n, n)`` (:func:`layer_response`, t
 matrix through a precomputed slot map (:func:`layer_assemble`, used by the model), which skips
 the blocks and their concatenation. Layers with the ``membrane_average`` option use the NumPy
 path.
+
+Layers whose rows factor into x- and z-functions at a tensor rule are evaluated instead by the
+sum-factorised kernel of :mod:`beam_element.sum_factor` (same integrand, same points, ξ summed
+first) where that saves enough flops (:func:`uses_sum_factorisation`): the enriched cores
+(levels ≥ 2). The paper's layers keep the packed kernel below.
 """
 
 from __future__ import annotations
@@ -32,12 +37,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from beam_element.layer_operators import LayerOperators
+from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
 from sandwich.solver.jit import njit
 
 __all__ = ["KernelOperators", "csr_slots", "embed_pattern", "kernel_operators", "layer_assemble",
-           "layer_blocks",
-           "layer_response",
-           "point_flops", "scatter_blocks", "supports"]
+           "layer_blocks", "layer_flops", "layer_response", "point_flops", "scatter_blocks",
+           "supports", "uses_sum_factorisation"]
 
 
 @dataclass(frozen=True)
@@ -339,6 +344,40 @@ _NO_SIGNS = np.empty((0, 0, 0), dtype=np.int8)
 _NO_DATA = np.empty(0)
 
 
+SUM_FACTORISATION = "auto"  # "auto" (by flops, below), "always" (where the rows factor), "never"
+# auto: factored when its flops × this < the packed kernel's. Measured (docs/beam_speed.md): at
+# the paper's core (2.2× fewer flops) the two take the same time, the factored kernel's smaller
+# GEMMs and gathers costing what its flops save; from level 2 on (5.6× and more) it is faster.
+FACTORED_OVERHEAD = 3.0
+
+
+def uses_sum_factorisation(op: LayerOperators) -> bool:
+    """Whether ``op`` is evaluated by the sum-factorised kernel (:mod:`beam_element.sum_factor`).
+
+    Only where the rows factor (tensor rule, every column an x-function times a z-function,
+    checked); then by :data:`SUM_FACTORISATION`: ``"auto"`` takes it when its flops
+    (:func:`~beam_element.sum_factor.factored_flops`) times :data:`FACTORED_OVERHEAD` are fewer
+    than the packed kernel's (:func:`point_flops` × G), i.e. the cores, not the faces. Decided
+    on the tangent's flops, for force-only calls too: a force is the same with or without its
+    tangent, bit for bit.
+    """
+    if SUM_FACTORISATION == "never":
+        return False
+    fo = factored_operators(op)
+    if fo is None:
+        return False
+    if SUM_FACTORISATION == "always":
+        return True
+    return FACTORED_OVERHEAD * factored_flops(fo) < op.eta.size * point_flops(op)
+
+
+def layer_flops(op: LayerOperators, tangent: bool = True) -> int:
+    """Flops per element of whichever kernel evaluates ``op`` (as executed)."""
+    if uses_sum_factorisation(op):
+        return factored_flops(factored_operators(op), tangent)
+    return op.eta.size * point_flops(op, tangent)
+
+
 def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
     k = kernel_operators(op)
     u_l = np.ascontiguousarray(u_l, dtype=float)
@@ -348,6 +387,14 @@ def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
     if lengths.shape != (u_l.shape[0],):
         raise ValueError(f"expected {u_l.shape[0]} element lengths, got {lengths.shape}")
     f = np.empty((u_l.shape[0], k.dofs.size))
+    if uses_sum_factorisation(op):
+        fo = factored_operators(op)
+        factored_kernel(u_l, lengths, float(width), fo.Xu, fo.Xdu, fo.ZuT, fo.ZduT, fo.iu,
+                        fo.ju, fo.Xw, fo.Xdw, fo.ZwT, fo.ZdwT, fo.iw, fo.jw, fo.Quu, fo.Puu,
+                        fo.Qww, fo.Pww, fo.Quw, fo.Puw, fo.entries, k.ucols, k.wcols,
+                        k.x_slope, k.weight, k.stiffness, k.thickness, f, want_k, K_out, slots,
+                        signs, data)
+        return f
     _kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww, k.Quw, k.pu,
             k.pw, k.ucols, k.wcols, k.x_slope, k.weight, k.stiffness, k.thickness, f,
             want_k, K_out, slots, signs, data)

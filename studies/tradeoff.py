@@ -221,6 +221,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="element counts of one variant (default: --elements)")
     ap.add_argument("--until", nargs="+", default=["paper-fig4-bonded-3pb=-12"],
                     metavar="SCENE=VALUE", help="end a scene's path at this probe value")
+    ap.add_argument("--scene-levels", nargs="+", default=[], metavar="SCENE=LEVEL,LEVEL",
+                    help="2D levels of one scene (default: --levels)")
     ap.add_argument("--out", type=Path, default=OUT)
     args = ap.parse_args(argv)
     per_variant = {}
@@ -232,6 +234,12 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"--variant-elements {item!r}: expected VARIANT=N,N,...")
         if name not in VARIANTS:
             ap.error(f"--variant-elements {item!r}: unknown variant {name!r}")
+    scene_levels = {}
+    for item in args.scene_levels:
+        name, _, levels = item.partition("=")
+        scene_levels[name] = [v for v in levels.split(",") if v]
+        if not scene_levels[name]:
+            ap.error(f"--scene-levels {item!r}: expected SCENE=LEVEL,LEVEL")
     until = {}
     for item in args.until:
         name, _, value = item.partition("=")
@@ -251,7 +259,8 @@ def main(argv: list[str] | None = None) -> int:
         if name in until:
             scene = with_until(scene, until[name])
         load = os.getloadavg()[0]
-        rs = measure(scene, beam_solve, ref_solve, args.elements, args.levels,
+        rs = measure(scene, beam_solve, ref_solve, args.elements,
+                     scene_levels.get(name, args.levels),
                      args.refine, tuple(args.variants), per_variant)
         runs += rs
         lines.append(headline(rs, name) + f" [path to {scene.analysis.until_probe} = "

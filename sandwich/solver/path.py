@@ -277,6 +277,14 @@ class _Follower:
         return state
 
     def finish(self, reached: bool, message: str) -> PathResult:
+        opt = self.opt
+        if (opt.until_probe is not None and opt.until_load_factor is None and self.states
+                and self.states[-1].load_factor < 0):
+            # The probe's target lies the other way from where the loads push it: the follower
+            # heads for it with λ < 0, which a user rarely means (a sign slip in until or force).
+            message += (f"; WARNING: {opt.until_probe} heads for {opt.until_value:g} only "
+                        "with λ < 0: every load's force is reversed (check the sign of "
+                        "analysis.until's value and of the loads' force)")
         if self.rescues:
             message += (f" ({len(self.rescues)} step(s) taken under control of "
                         f"{self.opt.until_probe} where the arc collapsed at a critical point: "

@@ -25,6 +25,15 @@ from sandwich.scene_file import load_scene
 SCENES = sorted((Path(__file__).resolve().parents[2] / "scenes").glob("*.toml"))
 
 
+def _bend_to_6mm(**beam_model):
+    """The nonlinear bend to w_top_mid = −6 mm, 40 elements, auto, ``[beam_model]`` changes."""
+    scene = sandwich_scene(elements=40, core_level="auto", analysis=Analysis(
+        kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
+        max_steps=200))
+    return dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, **beam_model))
+
+
 def _stiffness(model) -> float:
     u, _ = linear_solution(model, 1.0)
     return -1.0 / float(model.probe_vector("w_top_mid") @ u)
@@ -89,11 +98,7 @@ def test_zones_raise_the_levels_and_auto_keeps_them_as_a_floor():
 def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
     """Nonlinear bend to −6 mm: the linear step's choice is re-checked at the end of the path;
     a tight tolerance makes it rerun with more levels, and the final estimate is reported."""
-    scene = sandwich_scene(elements=40, core_level="auto", analysis=Analysis(
-        kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
-        max_steps=200))
-    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, tolerance=0.003, max_core_level=4))
+    scene = _bend_to_6mm(tolerance=0.003, max_core_level=4)
     r = run(scene)
     core = r.solution.extra["core"]
     stages = [p["stage"] for p in core["passes"]]
@@ -109,11 +114,7 @@ def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
     solve = sys.modules["beam_element.solve"]  # the module (the package exports a function)
     monkeypatch.setattr(solve, "RERUN_STEP_FACTOR", 0)
     monkeypatch.setattr(solve, "RERUN_MIN_STEPS", 2)
-    scene = sandwich_scene(elements=40, core_level="auto", analysis=Analysis(
-        kind="nonlinear", control="arc-length", until_probe="w_top_mid", until_value=-6.0,
-        max_steps=200))
-    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, tolerance=0.003, max_core_level=4))
+    scene = _bend_to_6mm(tolerance=0.003, max_core_level=4)
     r = run(scene)
     sol, core = r.solution, r.solution.extra["core"]
     paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
@@ -123,6 +124,23 @@ def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
     assert rerun["elements_per_level"] != first["elements_per_level"]
     assert level_counts(r.model.element_levels) == first["elements_per_level"]
     assert sol.final_load_factor == first["load_factor"]
+
+
+def test_no_rerun_is_read_as_convergence_once_the_zones_are_at_the_cap():
+    """Cap 2, with a core zone holding the load patch (± more than a core thickness) at 2: a
+    rerun could raise only elements away from the patch. auto does not rerun (that small change
+    would pass for convergence), keeps its estimate and says the zones are at the cap."""
+    plain = _bend_to_6mm()
+    load, h = plain.loads[0], plain.core.thickness
+    reach = load.width / 2 + h + 10.0
+    scene = _bend_to_6mm(tolerance=0.02, max_core_level=2,
+                         core_zones=(CoreZone(load.x - reach, load.x + reach, 2),))
+    r = run(scene)
+    core = r.solution.extra["core"]
+    paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
+    assert np.any(r.model.element_levels < 2)  # a rerun was possible elsewhere
+    assert len(paths) == 1 and core["zones_at_max_level"] is True, core["passes"]
+    assert "at max_core_level 2: what a further raise there" in r.solution.message
 
 
 @pytest.mark.heavy
