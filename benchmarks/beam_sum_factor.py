@@ -113,7 +113,7 @@ def path_rows(scenes):
                         "in_process_s": whole, "steps": len(s.history),
                         "iterations": s.extra.get("total_newton_iterations"),
                         "final_load_factor": s.history[-1].load_factor,
-                        "levels": s.extra.get("core_levels"), "load_before": before,
+                        "load_before": before,
                         "load_after": load()})
             print(out[-1], flush=True)
         kernels.SUM_FACTORISATION = "auto"

@@ -160,7 +160,10 @@ def test_ctrl_c_in_a_real_solve_keeps_the_converged_steps(tmp_path):
     proc = subprocess.Popen(
         [sys.executable, "-m", "sandwich_cli", "solve", str(ROOT / "scenes" / "default.toml"),
          "--model", "beam", "--out", str(out)],
-        cwd=tmp_path, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env)
+        cwd=tmp_path, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env,
+        # as a terminal's foreground job: a suite started in the background (`make test &`)
+        # hands its children SIGINT ignored, and Python then never raises KeyboardInterrupt
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     lines = []
     t0 = time.monotonic()
     for line in proc.stderr:  # not a terminal: one progress line per tenth of the way
