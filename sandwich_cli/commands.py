@@ -1,4 +1,4 @@
-"""The ``sandwich`` command: validate | mesh | solve | compare | gallery | demo.
+"""The ``sandwich`` command: validate | mesh | solve | compare | gallery | demo | study.
 
 Every command refuses a bad scene, bad option or unusable output folder before any work (exit
 code 2, one line per problem naming the file or option, the key and the reason). A solve that
@@ -36,6 +36,7 @@ examples:
   sandwich solve scenes/paper-fig5-top-debond-40-load-top.toml --model 2d --level coarse
   sandwich compare scenes/default.toml --out /tmp/cmp
   sandwich gallery --out /tmp/gallery
+  sandwich study studies/shipped/fig5-knockdown.toml --workers 2
 
 exit codes: 0 done, 1 stopped before the target or interrupted (converged steps written),
 2 bad input (scene, option or output folder; nothing solved), 3 internal error (crash log named)
@@ -46,6 +47,7 @@ QUIET_LOGGERS = ("UFL", "FFCx", "ffcx", "dolfinx", "py.warnings")
 RESULTS = Path("results")
 REFINE_RANGE = (0, 6)  # as the scene's [reference2d] refine
 ELEMENTS_RANGE = (2, 200_000)  # as the scene's [beam_model] elements
+WORKERS_MAX = 512
 
 
 class UsageError(ValueError):
@@ -283,6 +285,34 @@ def _version() -> str:
         return "sandwich (not installed)"
 
 
+def cmd_study(args: argparse.Namespace) -> int:
+    """Run (or resume) a design study: every case, the 2D spot checks, table, plots."""
+    from studies.study import run_study
+    from studies.study_file import load_study
+
+    study = load_study(args.study)
+    if args.workers is not None and not 1 <= args.workers <= WORKERS_MAX:
+        raise UsageError(f"option --workers: must be between 1 and {WORKERS_MAX}, "
+                         f"got {args.workers}")
+    out = Path(args.out) if args.out else RESULTS / "studies" / study.name
+    check_output_folder(out)
+    _say(args, f"{study.name}: {len(study.cases)} case(s), model {study.model}"
+         + (f", {study.check} 2D spot check(s)" if study.check else "") + f"; results in {out}/")
+    result = run_study(study, out, workers=args.workers or 2, scheduler=args.scheduler,
+                       say=lambda m: _say(args, m), quiet=args.quiet)
+    _say(args, f"table: {result.table}; summary: {result.summary}"
+         + "".join(f"; plot: {p}" for p in result.plots))
+    if result.interrupted:
+        print("interrupted: the finished cases are kept; run the same command to resume",
+              file=sys.stderr)
+        return EXIT_STOPPED
+    failed = sum(r.get("status") == "failed" for r in result.rows)
+    if failed:
+        print(f"{failed} case(s) failed (reasons in {result.table})", file=sys.stderr)
+        return EXIT_STOPPED
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``sandwich`` command."""
     p = argparse.ArgumentParser(
@@ -348,6 +378,17 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("scene", nargs="?", default=DEMO_SCENE,
                    help=f"scene file (default {DEMO_SCENE}, also from outside the checkout)")
     d.set_defaults(func=cmd_demo)
+
+    st = sub.add_parser("study", parents=[common],
+                        help="sweep a scene over its parameters (a study file), in parallel")
+    st.add_argument("study", help="study file (TOML, docs/studies.md)")
+    st.add_argument("--out", help="study folder: cases, table, plots (default "
+                                  "results/studies/<study>/); a rerun resumes it")
+    st.add_argument("--workers", type=int, metavar="N",
+                    help="local worker processes (default 2); ignored with --scheduler")
+    st.add_argument("--scheduler", metavar="ADDRESS",
+                    help="a Dask distributed scheduler (tcp://host:8786) to run the cases on")
+    st.set_defaults(func=cmd_study)
     return p
 
 

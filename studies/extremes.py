@@ -1,35 +1,29 @@
-"""Stability at the extremes: both models over sweeps, starting from the Fig 5 scene.
+"""Stability at the extremes: both models over sweeps from the Fig 5 scene, as five studies.
 
 The sweeps are of stiffness, thickness, slenderness, debond length and load level, from the
-Fig 5 scene (top debond, load on top).
+Fig 5 scene (top debond, load on top). Each is a shipped study file,
+``studies/shipped/extremes-<sweep>.toml`` (one axis, the beam at 240 graded elements and core
+level 1, ``check = "all"``: the 2D model at level coarse on every case, a wall-time cap per case
+and a 2D cell budget), run by the one study engine (:mod:`studies.study`, ``sandwich study``);
+this module only turns the studies' stored cases into the map (it has no runner of its own).
 
 Every case gets a row, whether its models ran or not. Per case and model: status (converged,
 stopped before the target, failed, timeout, skipped with the reason), how far along the path it
-got (|until probe| reached / |target|), steps, Newton iterations, step cuts (the ``cuts`` of each
-converged path state, i.e. halvings of the increment before it converged, taken from the path
-follower's progress callback; ``cuts`` in the history when a model records only that) and wall
-time. Per case the agreement of the two load curves, beam against 2D, as functions of |until
-probe| (:mod:`comparisons.paths`):
+got (|until probe| reached / |target|), steps, Newton iterations, step cuts (``cuts`` recorded in
+the history, when a model records it) and wall time. Per case the agreement of the two load
+curves, beam against 2D, as functions of |until probe| (:mod:`comparisons.paths`):
 
 - ``load_l2``: relative L2 over the common range of both paths (``common`` = its end / |target|;
   below 1 when a model stopped early, and the note says which);
 - ``load_l2_lin``: the same over the first 10 % of the target (the linear range);
 - ``end_error``: (λ_beam − λ_2D) / |λ_2D| at the end of the common range.
 
-Optionally (``--check-level medium``) the 2D model is run a second time at a finer level, and the
-beam is also compared with that run (``beam_vs_check_*``) and the 2D runs with each other
-(``check_end_error``: coarse against the finer level, the discretisation error of the reference).
-
-Budgets, so that no case can hang the sweep: each model runs in a child process with a wall-time
-cap (``--timeout``); the path states it streamed before the cap are kept, and the row says
-"timeout". The 2D model is skipped (with the cell count in the reason) when its mesh would exceed
-``--max-cells``.
-
 Writes ``extremes.csv``, ``extremes.md`` and ``extremes.png`` into
-``benchmarks/results/comparisons/`` after every case (a crash or an interrupt keeps the rows done).
+``benchmarks/results/comparisons/`` after every sweep (the cases themselves are kept in the
+studies' folders: an interrupted map resumes with every finished case reused).
 
-Usage: ``python benchmarks/extremes.py [--sweeps stiffness ...] [--quick] [--timeout S]
-[--max-cells N] [--elements N] [--level coarse] [--check-level medium] [--parallel]``
+Usage: ``python benchmarks/extremes.py [--sweeps stiffness ...] [--workers N] [--scheduler
+ADDRESS] [--studies DIR] [--out DIR] [--render]``
 """
 
 from __future__ import annotations
@@ -38,12 +32,8 @@ import argparse
 import csv
 import dataclasses
 import math
-import multiprocessing
-import os
 import re
-import signal
 import time
-import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -54,30 +44,29 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from comparisons.paths import LOAD, curve_error, path_curve, path_parameter  # noqa: E402
-from models import get_model, with_options  # noqa: E402
-from sandwich.results import Solution, StepRecord  # noqa: E402
+from sandwich.results import Solution, load_result  # noqa: E402
 from sandwich.scene import Debond, Layer, Load, Probe, Scene, Support  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
+from studies.study import run_study  # noqa: E402
+from studies.study_file import Study, load_study  # noqa: E402
+from studies.study_run import case_folder  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]  # the project: scenes/, benchmarks/results/
 OUT = ROOT / "benchmarks" / "results" / "comparisons"
 BASE = "paper-fig5-top-debond-40-load-top"
-SWEEPS = {
+STUDIES = ROOT / "studies" / "shipped"  # extremes-<sweep>.toml
+STUDY_OUT = ROOT / "results" / "studies"  # the studies' own folders (cases, tables)
+SWEEPS = {  # the values of the study files' axes (tests/study checks they agree)
     "stiffness": [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6],  # E_core / E_face
     "thickness": [10, 50, 100, 500],  # t_core / t_face
     "slenderness": [5, 20, 100, 1000],  # L / h
-    "debond": [0.0, 0.1, 0.3, 0.6, 0.9, 1.0],  # debond length / span
+    # debond length / span; 1.0 (the whole top face debonded, load on it) is a mechanism the
+    # scene checks refuse before any solve (both models failed on it at step 1 before)
+    "debond": [0.0, 0.1, 0.3, 0.6, 0.9],
     "load": [0.25, 0.5, 1.0, 2.0],  # until value / the scene's
 }
 LINEAR_FRACTION = 0.1  # the "linear range": the first 10 % of the until target
-DEFAULTS = {"elements": 240, "level": "coarse", "timeout": 600.0, "max_cells": 20000}
-QUICK = {"elements": 60, "level": "coarse", "timeout": 90.0, "max_cells": 3000}
 MODELS = ("beam", "2d")
 CHECK = "2d_check"  # the optional finer 2D run
-
-
-class Skipped(Exception):
-    """A model not run on a case, with the reason (e.g. its mesh exceeds the cell budget)."""
 
 
 def _core_stiffness(scene: Scene, ratio: float) -> Scene:
@@ -146,31 +135,6 @@ class Outcome:
     info: dict = dataclasses.field(default_factory=dict)  # what a solver told before solving
 
 
-def _state_tuple(state: object) -> tuple:
-    return (int(getattr(state, "step", 0)), float(state.load_factor), dict(state.probes),
-            int(getattr(state, "iterations", 0)), int(getattr(state, "cuts", 0)))
-
-
-def _light(sol: Solution) -> Solution:
-    """The solution without profiles and field frames (all the sweep needs; cheap to send)."""
-    extra = {k: v for k, v in sol.extra.items() if isinstance(v, int | float | str | bool)}
-    return dataclasses.replace(sol, profiles=[], fields=[], extra=extra)
-
-
-def _partial(model: str, scene: Scene, states: list[tuple], message: str,
-             seconds: float) -> Solution | None:
-    """A solution built from the path states a model streamed before it was stopped."""
-    if not states:
-        return None
-    hist = [StepRecord(s, lam, probes, its, {"cuts": float(c)})
-            for s, lam, probes, its, c in states]
-    return Solution(model, scene.name, hist, [], False, message, [], seconds, 0)
-
-
-def _classify(sol: Solution) -> str:
-    return "converged" if sol.converged else "stopped"
-
-
 def _label(r: dict[str, object], model: str) -> str:
     """The status of the map: a stopped path that got past the target only missed hitting it."""
     st = str(r.get(f"{model}_status", "missing"))
@@ -178,122 +142,6 @@ def _label(r: dict[str, object], model: str) -> str:
     if st == "stopped" and reached not in (None, "") and float(reached) >= 1.0:
         return "crossed"
     return st
-
-
-def _child(solve: Callable, scene: Scene, conn) -> None:  # pragma: no cover - runs in a fork
-    try:
-        sol = solve(scene, progress=lambda st: conn.send(
-            ("info", st) if isinstance(st, dict) else ("note", str(getattr(st, "message", "")))
-            if getattr(st, "probes", None) is None else ("state", _state_tuple(st))))
-        conn.send(("done", _light(sol)))
-    except Skipped as exc:
-        conn.send(("skipped", str(exc)))
-    except BaseException as exc:  # noqa: BLE001 - every failure is a row of the map
-        tb = traceback.extract_tb(exc.__traceback__)
-        where = f" ({Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
-        conn.send(("failed", f"{type(exc).__name__}: {exc}{where}"))
-    finally:
-        conn.close()
-
-
-def run_models(scene: Scene, solvers: dict[str, Callable], timeout: float | None = None,
-               parallel: bool = False) -> dict[str, Outcome]:
-    """Run every solver on ``scene``; each is ``solve(scene, progress=callback) -> Solution``.
-
-    With ``timeout`` (s) each runs in a forked child process killed at the cap (the states it
-    reported are kept); without, in this process. ``parallel`` starts all children at once.
-    """
-    if timeout is None:
-        return {m: _run_inline(m, scene, solve) for m, solve in solvers.items()}
-    ctx = multiprocessing.get_context("fork")
-    out: dict[str, Outcome] = {}
-    order = list(solvers)
-    while order:
-        batch, order = (order, []) if parallel else (order[:1], order[1:])
-        jobs = {}
-        for m in batch:
-            rd, wr = ctx.Pipe(duplex=False)
-            p = ctx.Process(target=_child, args=(solvers[m], scene, wr), daemon=True)
-            t0 = time.perf_counter()
-            p.start()
-            wr.close()
-            jobs[m] = (p, rd, t0, [], None, {})
-        while jobs:
-            for m in list(jobs):
-                p, rd, t0, states, final, info = jobs[m]
-                elapsed = time.perf_counter() - t0
-                ended = False
-                try:
-                    while rd.poll(0.05):
-                        kind, payload = rd.recv()
-                        if kind == "state":
-                            states.append(payload)
-                        elif kind == "note":  # the model reruns the path from its start
-                            states.clear()
-                        elif kind == "info":
-                            info.update(payload)
-                        else:
-                            final = (kind, payload)
-                except EOFError:
-                    ended = True
-                jobs[m] = (p, rd, t0, states, final, info)
-                elapsed = time.perf_counter() - t0
-                if final is not None or ended or (not p.is_alive() and not rd.poll(0)):
-                    p.join(10)
-                    if p.is_alive():  # answered but hangs on exit: our own child
-                        os.kill(p.pid, signal.SIGKILL)
-                        p.join(5)
-                    out[m] = _finish(m, scene, states, final, elapsed, p.exitcode)
-                    out[m].info = info
-                    rd.close()
-                    del jobs[m]
-                elif elapsed > timeout:
-                    os.kill(p.pid, signal.SIGKILL)  # our own child; its states are kept
-                    p.join(5)
-                    msg = (f"stopped by the benchmark's wall-time cap of {timeout:g} s after "
-                           f"{len(states)} states")
-                    sol = _partial(m, scene, states, msg, elapsed)
-                    out[m] = Outcome(m, "timeout", sol, msg, elapsed,
-                                     sum(s[4] for s in states), info)
-                    rd.close()
-                    del jobs[m]
-    return out
-
-
-def _finish(model: str, scene: Scene, states: list[tuple], final, seconds: float,
-            exitcode: int | None) -> Outcome:
-    cuts = sum(s[4] for s in states)
-    if final is None:
-        msg = f"the model's process ended without an answer (exit code {exitcode})"
-        return Outcome(model, "failed", _partial(model, scene, states, msg, seconds), msg,
-                       seconds, cuts)
-    kind, payload = final
-    if kind == "done":
-        if not states:  # a solver that does not report states: cuts from its history
-            cuts = _history_cuts(payload)
-        return Outcome(model, _classify(payload), payload, payload.message, seconds, cuts)
-    sol = _partial(model, scene, states, payload, seconds)
-    return Outcome(model, kind, sol, payload, seconds, cuts)
-
-
-def _run_inline(model: str, scene: Scene, solve: Callable) -> Outcome:
-    states: list[tuple] = []
-    info: dict = {}
-    t0 = time.perf_counter()
-    try:
-        sol = solve(scene, progress=lambda st: info.update(st) if isinstance(st, dict)
-                    else states.clear() if getattr(st, "probes", None) is None
-                    else states.append(_state_tuple(st)))
-    except Skipped as exc:
-        return Outcome(model, "skipped", None, str(exc), time.perf_counter() - t0, 0, info)
-    except Exception as exc:  # recorded in the map, the sweep goes on
-        seconds = time.perf_counter() - t0
-        msg = f"{type(exc).__name__}: {exc}"
-        return Outcome(model, "failed", _partial(model, scene, states, msg, seconds), msg,
-                       seconds, sum(s[4] for s in states), info)
-    seconds = time.perf_counter() - t0
-    cuts = sum(s[4] for s in states) if states else _history_cuts(sol)
-    return Outcome(model, _classify(sol), sol, sol.message, seconds, cuts, info)
 
 
 def _history_cuts(sol: Solution) -> int:
@@ -378,7 +226,7 @@ def row(sweep: str, value: float, scene: Scene, runs: dict[str, Outcome]) -> dic
     """The map's row of one case."""
     out: dict[str, object] = {"sweep": sweep, "value": value}
     for model in (*MODELS, *([CHECK] if CHECK in runs else [])):
-        r = runs.get(model) or Outcome(model, "missing", None, "not importable")
+        r = runs.get(model) or Outcome(model, "missing", None, "not run")
         s = r.solution
         out[f"{model}_status"] = r.status
         out[f"{model}_converged"] = r.status == "converged"
@@ -551,59 +399,57 @@ def _plot(rows: list[dict[str, object]], path: Path) -> None:
     plt.close(fig)
 
 
-# -- the real models ------------------------------------------------------------------------------
+# -- the map from the studies' cases ---------------------------------------------------------------
 
-def real_solvers(elements: int, level: str, max_cells: int,
-                 check_level: str | None = None) -> dict[str, Callable]:
-    """The registry's beam at ``elements`` and 2D model at ``level`` (refused above ``max_cells``).
+STATUS = {"done": "converged", "stopped": "stopped", "failed": "failed", "timeout": "timeout",
+          "skipped": "skipped"}
 
-    Resolutions are set in the scene's options tables (:func:`models.with_options`), as the
-    command line does, so a case is solved exactly as ``sandwich solve`` would solve it.
-    """
-    beam_spec, ref_spec = get_model("beam"), get_model("2d")
 
-    def beam(scene, progress=None):
-        return beam_spec.solve(with_options(scene, "beam", elements=elements), progress)
+def outcome(model: str, record: dict | None, folder: Path) -> Outcome:
+    """A study case's record and stored result set as the map's :class:`Outcome`."""
+    if record is None:
+        return Outcome(model, "missing", None, "not run")
+    sol = None
+    if (folder / "summary.json").is_file():
+        try:
+            sol = load_result(folder)
+        except (OSError, ValueError, KeyError):
+            sol = None
+    status = STATUS.get(str(record.get("status")), "failed")
+    seconds = float(record.get("wall_seconds") or 0.0)
+    return Outcome(model, status, sol, str(record.get("reason") or (sol.message if sol else "")),
+                   seconds, _history_cuts(sol) if sol else 0)
 
-    def two_d(lvl):
-        def solve(scene, progress=None):
-            from meshes import build_mesh
 
-            scene = with_options(scene, "2d", level=lvl)
-            cells = len(build_mesh(scene).cells)
-            if progress is not None:  # a dict is information, not a path state
-                progress({"cells": cells})
-            if cells > max_cells:
-                raise Skipped(f"2D mesh at level {lvl} has {cells} cells, above the "
-                              f"benchmark's budget of {max_cells}")
-            return ref_spec.solve(scene, progress)
-        return solve
-
-    solvers: dict[str, Callable] = {"beam": beam, "2d": two_d(level)}
-    if check_level:
-        solvers[CHECK] = two_d(check_level)
-    return solvers
+def map_rows(sweep: str, study: Study, result, out: Path) -> list[dict[str, object]]:
+    """The map's rows of one sweep's study run (``result``: :class:`studies.study.StudyResult`)."""
+    rows = []
+    axis = study.axes[0]
+    for case in study.cases:
+        value = float(case.values[axis.name])
+        if sweep == "debond":
+            value = value / case.scene.length
+        beam = outcome("beam", result.cases.records.get(case.index),
+                       case_folder(out, case, "beam"))
+        checks = result.checks.records if result.checks else {}
+        ref = outcome("2d", checks.get(case.index), case_folder(out, case, "2d-check"))
+        r = row(sweep, value, case.scene, {"beam": beam, "2d": ref})
+        r.update(elements=case.scene.beam_model.elements, level=case.scene.reference2d.level,
+                 cap_s=study.timeout, max_cells=study.max_cells, case=case.index,
+                 finished=time.strftime("%Y-%m-%d %H:%M:%S"))
+        rows.append(r)
+    return rows
 
 
 def main(argv: list[str] | None = None) -> int:
-    """The sweep's command line (``python benchmarks/extremes.py --help``)."""
-    ap = argparse.ArgumentParser(description="stability sweep of both models")
+    """The map's command line (``python benchmarks/extremes.py --help``)."""
+    ap = argparse.ArgumentParser(description="stability map of both models, from the five "
+                                             "extremes studies")
     ap.add_argument("--sweeps", nargs="+", default=list(SWEEPS), choices=list(SWEEPS))
-    ap.add_argument("--values", nargs="+", type=float, default=None,
-                    help="only these values of the sweep(s)")
-    ap.add_argument("--quick", action="store_true",
-                    help=f"smoke run: {QUICK} (a map at these settings is not the reference map)")
-    ap.add_argument("--elements", type=int, help="beam elements (default 240)")
-    ap.add_argument("--level", help="2D mesh level (default coarse)")
-    ap.add_argument("--timeout", type=float, help="wall-time cap per model and case, s")
-    ap.add_argument("--max-cells", type=int, help="largest 2D mesh run (cells)")
-    ap.add_argument("--check-level", default=None,
-                    help="also run the 2D model at this level (e.g. medium) and compare to it")
-    ap.add_argument("--check-sweeps", nargs="+", default=None, choices=list(SWEEPS),
-                    help="sweeps the check level is run on (default: all selected)")
-    ap.add_argument("--parallel", action="store_true", help="run the models of a case at once")
-    ap.add_argument("--append", action="store_true",
-                    help="keep the rows of extremes.csv in --out that this run does not redo")
+    ap.add_argument("--workers", type=int, default=2, help="local worker processes")
+    ap.add_argument("--scheduler", help="a Dask scheduler address to run the cases on")
+    ap.add_argument("--studies", type=Path, default=STUDY_OUT,
+                    help="parent folder of the studies' own folders (resumed if there)")
     ap.add_argument("--render", action="store_true",
                     help="only redraw extremes.md/.png from extremes.csv in --out")
     ap.add_argument("--note", action="append", default=[],
@@ -612,55 +458,25 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.render:
         rows = [_parse(r) for r in csv.DictReader((args.out / "extremes.csv").open())]
-        head = (args.out / "extremes.md").read_text().splitlines()[2:3] if (
-            args.out / "extremes.md").is_file() else []
-        write(rows, args.out, [*head, *args.note, ""])
+        write(rows, args.out, [*args.note, ""])
         return 0
-    cfg = dict(QUICK if args.quick else DEFAULTS)
-    for k in cfg:
-        if getattr(args, k) is not None:
-            cfg[k] = getattr(args, k)
-    solvers = real_solvers(cfg["elements"], cfg["level"], cfg["max_cells"], args.check_level)
-    base = load_scene(ROOT / "scenes" / f"{BASE}.toml")
-    header = [f"Settings: beam {cfg['elements']} graded elements (paper element); 2D level "
-              f"{cfg['level']}; wall-time cap {cfg['timeout']:g} s per model and case; 2D cell "
-              f"budget {cfg['max_cells']}" + (f"; 2D check level {args.check_level}"
-                                               if args.check_level else "")
-              + (" (--quick: a smoke run, not the reference map)" if args.quick else "") + ".",
-              *args.note, ""]
     rows: list[dict[str, object]] = []
-    if args.append and (args.out / "extremes.csv").is_file():
-        rows = [_parse(r) for r in csv.DictReader((args.out / "extremes.csv").open())]
-    for sweep, value, scene in cases(base, args.sweeps):
-        if args.values is not None and not any(math.isclose(value, v) for v in args.values):
-            continue
-        use = dict(solvers)
-        if CHECK in use and args.check_sweeps and sweep not in args.check_sweeps:
-            del use[CHECK]
-        print(f"{sweep} = {value:g}", flush=True)
-        r = row(sweep, value, scene, run_models(scene, use, cfg["timeout"], args.parallel))
-        r.update(elements=cfg["elements"], level=cfg["level"], cap_s=cfg["timeout"],
-                 max_cells=cfg["max_cells"], check_level=args.check_level if CHECK in use
-                 else None, commit=_commit(), finished=time.strftime("%Y-%m-%d %H:%M:%S"))
-        print("   " + ", ".join(f"{m}: {r[f'{m}_status']} {r[f'{m}_seconds']} s"
-                                for m in use) + f"; L2 {_pct(r['load_l2'])}", flush=True)
-        rows = [x for x in rows if not (x["sweep"] == sweep and math.isclose(float(x["value"]),
-                                                                                value))]
-        rows.append(r)
+    for sweep in args.sweeps:
+        study = load_study(STUDIES / f"extremes-{sweep}.toml")
+        out = args.studies / study.name
+        print(f"{sweep}: {len(study.cases)} cases, study folder {out}", flush=True)
+        result = run_study(study, out, workers=args.workers, scheduler=args.scheduler)
+        rows = [r for r in rows if r["sweep"] != sweep] + map_rows(sweep, study, result, out)
         rows.sort(key=lambda x: (list(SWEEPS).index(x["sweep"]), _index(x)))
-        write(rows, args.out, header)  # partial map survives a crash or an interrupt
+        header = [f"Settings: the studies studies/shipped/extremes-*.toml (beam "
+                  f"{study.cases[0].scene.beam_model.elements} graded elements, core level 1; "
+                  f"2D level {study.cases[0].scene.reference2d.level} on every case; wall-time "
+                  f"cap {study.timeout:g} s per case; 2D cell budget {study.max_cells}).",
+                  *args.note, ""]
+        write(rows, args.out, header)  # the map so far survives a crash or an interrupt
+        if result.interrupted:
+            return 1
     return 0 if rows else 1
-
-
-def _commit() -> str:
-    """The repository's HEAD when a case finished (models are imported afresh per case)."""
-    import subprocess
-
-    try:
-        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
-                              capture_output=True, text=True, timeout=10).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        return ""
 
 
 def _index(r: dict[str, object]) -> int:

@@ -17,7 +17,7 @@ ALLOWED = {
     "models": {"sandwich", "beam_element", "meshes", "reference2d"},
     "comparisons": {"sandwich", "models"},
     "studies": {"sandwich", "beam_element", "meshes", "reference2d", "models", "comparisons"},
-    "sandwich_cli": {"sandwich", "meshes", "models", "comparisons"},
+    "sandwich_cli": {"sandwich", "meshes", "models", "comparisons", "studies"},
 }
 PACKAGES = set(ALLOWED)
 
