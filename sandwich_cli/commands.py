@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import glob
-import logging
 import signal
 import sys
 import tempfile
@@ -23,6 +22,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from models import MODELS, PROJECT_ROOT, ModelRun, mpi_rank, run_model, with_options
+from sandwich.quiet_logs import hush_libraries, unhush_libraries
 from sandwich.results import OutputError, check_output_folder
 from sandwich.scene import MESH_LEVELS, Scene, SceneError
 from sandwich.scene_file import load_scene
@@ -43,7 +43,6 @@ exit codes: 0 done, 1 stopped before the target or interrupted (converged steps 
 """
 # Loggers of the FEniCSx stack: their warnings and the JIT compiler's INFO lines are shown only
 # with --verbose (the 2D model's first run compiles its forms)
-QUIET_LOGGERS = ("UFL", "FFCx", "ffcx", "dolfinx", "py.warnings")
 RESULTS = Path("results")
 REFINE_RANGE = (0, 6)  # as the scene's [reference2d] refine
 ELEMENTS_RANGE = (2, 200_000)  # as the scene's [beam_model] elements
@@ -392,38 +391,6 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-class _Below(logging.Filter):
-    """Drops records below a level (a filter: the libraries reset their loggers' levels)."""
-
-    def __init__(self, level: int):
-        super().__init__()
-        self.level = level
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return record.levelno >= self.level
-
-
-def _hush_libraries() -> None:
-    """Keep the FEniCSx stack's log lines off the terminal (shown with ``--verbose``).
-
-    The JIT compiler logs "INFO:root:running build_ext ..." on the root logger (setuptools sets
-    its level to INFO), UFL warns about the DQ element on its own logger with its own handler:
-    filters on those loggers hold whatever levels the libraries set later.
-    """
-    _unhush_libraries()
-    logging.getLogger().addFilter(_Below(logging.WARNING))
-    for name in QUIET_LOGGERS:
-        logging.getLogger(name).addFilter(_Below(logging.ERROR))
-
-
-def _unhush_libraries() -> None:
-    """Remove the filters of :func:`_hush_libraries` (``main`` returns to a caller)."""
-    for name in ("", *QUIET_LOGGERS):
-        logger = logging.getLogger(name)
-        for f in [f for f in logger.filters if isinstance(f, _Below)]:
-            logger.removeFilter(f)
-
-
 def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
@@ -455,7 +422,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "verbose", False):
-        _hush_libraries()
+        unhush_libraries()
+        hush_libraries()
     try:
         previous = signal.signal(signal.SIGTERM, _interrupt)
     except ValueError:  # not the main thread (tests driving main in a thread)
@@ -478,6 +446,6 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return EXIT_INTERNAL
     finally:
-        _unhush_libraries()
+        unhush_libraries()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

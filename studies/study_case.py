@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import logging
 import math
 import os
 import signal
@@ -23,12 +22,12 @@ from pathlib import Path
 from typing import Any
 
 from models import PROJECT_ROOT, get_model, obtain, stored_identity, with_options
+from sandwich.quiet_logs import hush_libraries
 from sandwich.results import load_result
 from sandwich.scene import MAX_CORE_LEVEL, Scene
 from studies.study_metrics import case_metrics
 
 CASE_FILE = "case.json"
-QUIET_LOGGERS = ("UFL", "FFCx", "ffcx", "dolfinx", "py.warnings")  # as sandwich_cli's
 LOOKAHEAD = 2  # the indicator compares the case's core level with this many levels more
 
 
@@ -129,25 +128,8 @@ def prepare_2d() -> bool:
     handlers unchanged instead of raising (a worker's tasks are never interrupted by Ctrl-C).
     """
     signal.signal = _signal_on_main_thread_only
-    for name in QUIET_LOGGERS:  # the FEniCSx stack's notes, held back as the command line does
-        logger = logging.getLogger(name)  # (a filter: the libraries reset their levels)
-        if not any(isinstance(f, _Below) for f in logger.filters):
-            logger.addFilter(_Below(logging.ERROR))
-    root = logging.getLogger()  # the JIT compiler's INFO lines
-    if not any(isinstance(f, _Below) for f in root.filters):
-        root.addFilter(_Below(logging.WARNING))
+    hush_libraries()  # the FEniCSx stack's notes, held back as the command line does
     return True
-
-
-class _Below(logging.Filter):
-    """Drops log records below a level."""
-
-    def __init__(self, level: int):
-        super().__init__()
-        self.level = level
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return record.levelno >= self.level
 
 
 def solve_case(task: dict[str, Any]) -> dict[str, Any]:

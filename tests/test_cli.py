@@ -87,7 +87,7 @@ def test_progress_is_a_few_lines_when_not_a_terminal(tmp_path):
 def test_library_log_lines_are_held_back_unless_verbose():
     import logging
 
-    from sandwich_cli.commands import _hush_libraries, _unhush_libraries
+    from sandwich.quiet_logs import hush_libraries, unhush_libraries
 
     seen = []
     handler = logging.Handler()
@@ -95,12 +95,12 @@ def test_library_log_lines_are_held_back_unless_verbose():
     root = logging.getLogger()
     root.addHandler(handler)
     try:
-        _hush_libraries()
+        hush_libraries()
         root.setLevel(logging.INFO)  # as setuptools does when the 2D forms are compiled
         root.info("running build_ext")
         logging.getLogger("UFL").warning("Discontinuous Lagrange element requested")
         root.error("a real error")
-        _unhush_libraries()
+        unhush_libraries()
         root.info("shown again")
     finally:
         root.removeHandler(handler)
