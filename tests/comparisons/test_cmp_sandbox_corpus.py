@@ -32,8 +32,6 @@ SCENE_EDITS = {  # fig5 scene text: (old, new)
     "tiny width": ("width = 60.0", "width = 1e-300"),
     "deeply nested TOML": ("[beam]", "bomb = " + "[" * 50_000 + "]" * 50_000 + "\n[beam]"),
 }
-SCENE_FILES = ("folder as scene", "FIFO as scene", "unreadable scene", "NUL in the path",
-               "300-character path")
 OPTIONS = {  # option classes: argv, and the commands taking it
     "--refine -3": (["--refine", "-3"], ("solve-2d", "mesh")),
     "--refine 9": (["--refine", "9"], ("solve-2d", "mesh")),
@@ -42,7 +40,6 @@ OPTIONS = {  # option classes: argv, and the commands taking it
     "--level on the beam": (["--level", "fine"], ("solve-beam",)),
     "--elements on the 2D model": (["--elements", "40"], ("solve-2d",)),
 }
-OUTS = ("--out is a file", "--out read-only", "--out with NUL", "--out 300-character name")
 COMMANDS = ("validate", "solve-beam", "solve-2d", "mesh", "compare")
 
 
@@ -125,24 +122,54 @@ def test_a_hostile_scene_is_refused_and_writes_nothing(tmp_path, scene_file, fak
     assert str(scene_file) in err and fake_models == []
 
 
+def _folder(tmp_path, scene_file, monkeypatch):
+    (tmp_path / "folder.toml").mkdir()
+    return tmp_path / "folder.toml"
+
+
+def _fifo(tmp_path, scene_file, monkeypatch):
+    os.mkfifo(tmp_path / "pipe.toml")
+    return tmp_path / "pipe.toml"
+
+
+def _unreadable_scene(tmp_path, scene_file, monkeypatch):
+    _unreadable(scene_file, monkeypatch)
+    return scene_file
+
+
+SCENE_PATHS = {  # case: (tmp_path, scene_file, monkeypatch) -> the scene path given
+    "folder as scene": _folder,
+    "FIFO as scene": _fifo,
+    "unreadable scene": _unreadable_scene,
+    "NUL in the path": lambda tmp, scene, mp: Path(str(scene) + "\0.toml"),
+    "300-character path": lambda tmp, scene, mp: tmp / ("y" * 300 + ".toml"),
+}
+
+
+def _out_file(tmp_path, monkeypatch):
+    (tmp_path / "file").write_text("x")
+    return tmp_path / "file"
+
+
+def _out_read_only(tmp_path, monkeypatch):
+    _read_only(tmp_path / "ro", monkeypatch)
+    return tmp_path / "ro" / "sub"
+
+
+OUTS = {  # case: (tmp_path, monkeypatch) -> the --out given
+    "--out is a file": _out_file,
+    "--out read-only": _out_read_only,
+    "--out with NUL": lambda tmp, mp: Path(str(tmp / "o") + "\0x"),
+    "--out 300-character name": lambda tmp, mp: tmp / ("z" * 300) / "sub",
+}
+
+
 @pytest.mark.parametrize("command", COMMANDS)
-@pytest.mark.parametrize("case", SCENE_FILES)
+@pytest.mark.parametrize("case", sorted(SCENE_PATHS))
 def test_a_scene_path_that_is_not_a_readable_file_is_refused(tmp_path, scene_file, fake_models,
                                                              monkeypatch, capsys, case,
                                                              command):
-    if case == "folder as scene":
-        path = tmp_path / "folder.toml"
-        path.mkdir()
-    elif case == "FIFO as scene":
-        path = tmp_path / "pipe.toml"
-        os.mkfifo(path)
-    elif case == "unreadable scene":
-        path = scene_file
-        _unreadable(path, monkeypatch)
-    elif case == "NUL in the path":
-        path = Path(str(scene_file) + "\0.toml")
-    else:
-        path = tmp_path / ("y" * 300 + ".toml")
+    path = SCENE_PATHS[case](tmp_path, scene_file, monkeypatch)
     err = _run(tmp_path, monkeypatch, capsys, _argv(command, str(path)))
     assert fake_models == [] and " -: " in err
 
@@ -158,20 +185,11 @@ def test_a_bad_option_is_refused_and_writes_nothing(tmp_path, scene_file, fake_m
 
 
 @pytest.mark.parametrize("command", [c for c in COMMANDS if c != "validate"])
-@pytest.mark.parametrize("case", OUTS)
+@pytest.mark.parametrize("case", sorted(OUTS))
 def test_an_unusable_output_folder_is_refused_before_any_work(tmp_path, scene_file, fake_models,
                                                               monkeypatch, capsys, case,
                                                               command):
-    if case == "--out is a file":
-        out = tmp_path / "file"
-        out.write_text("x")
-    elif case == "--out read-only":
-        _read_only(tmp_path / "ro", monkeypatch)
-        out = tmp_path / "ro" / "sub"
-    elif case == "--out with NUL":
-        out = Path(str(tmp_path / "o") + "\0x")
-    else:
-        out = tmp_path / ("z" * 300) / "sub"
+    out = OUTS[case](tmp_path, monkeypatch)
     err = _run(tmp_path, monkeypatch, capsys,
                [*_argv(command, str(scene_file)), "--out", str(out)])
     assert fake_models == [] and ("folder" in err or "writable" in err)
