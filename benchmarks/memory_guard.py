@@ -44,6 +44,7 @@ BEAM_ROWS = [  # (role, elements, core)
 TWO_D_ROWS = [  # (role, command, level, refine)
     ("fit", "mesh", "coarse", 0), ("fit", "mesh", "medium", 0), ("fit", "mesh", "coarse", 1),
     ("fit", "mesh", "coarse", 2), ("fit", "mesh", "fine", 1), ("check", "mesh", "coarse", 3),
+    ("check", "mesh", "coarse", 6),
     ("fit", "solve", "coarse", 0), ("fit", "solve", "medium", 0), ("fit", "solve", "coarse", 1),
     ("fit", "solve", "coarse", 2), ("fit", "solve", "fine", 0), ("check", "solve", "coarse", 3),
 ]
