@@ -2,7 +2,8 @@
 
 Every row runs the real command line (``python -m sandwich_cli solve|mesh ... --quiet``) on a
 variant of ``scenes/default.toml`` in its own process and reads that process's peak resident set
-size from ``os.wait4`` (``ru_maxrss``, the kernel's high-water mark of the whole process). The
+size from ``os.wait4`` (``ru_maxrss``, the kernel's high-water mark of the whole process), read
+by a small launcher process (:data:`LAUNCHER`). The
 beam rows follow a short path (until w_top_mid = UNTIL mm) at a given element count and core
 level; the 2D rows mesh only (``sandwich mesh``) or solve ``max_steps = 2`` steps at a mesh level
 and refinement. The 1-minute load average is recorded before and after each row (the machine has
@@ -65,17 +66,32 @@ def two_d_scene(level: str, refine: int, steps: int) -> str:
     return text.replace("max_steps = 400", f"max_steps = {steps}")
 
 
+# The command is started by this small launcher process, which reads the command's rusage. Linux
+# keeps the high-water RSS across exec, and a child forked (or vforked) from a large process
+# (a test run that has loaded FEniCSx) starts with the parent's pages counted: started from a
+# fresh small process, the peak is the command's own (+ the launcher's ~10 MB).
+LAUNCHER = """import json, os, sys
+pid = os.posix_spawn(sys.argv[2], sys.argv[2:], os.environ)
+_, status, usage = os.wait4(pid, 0)
+with open(sys.argv[1], "w") as fh:
+    json.dump({"exit": os.waitstatus_to_exitcode(status), "maxrss_kb": usage.ru_maxrss}, fh)
+"""
+
+
 def measure(argv: list[str], cwd: Path) -> dict:
-    """Run ``argv``; its exit code, wall seconds, peak RSS (bytes) and stdout."""
+    """Run ``argv`` (its first item an absolute path) in ``cwd``; exit code, wall seconds, peak
+    RSS (bytes), the load before and after, the tails of stdout and stderr."""
     env = {**os.environ, "XDG_CACHE_HOME": str(ROOT / ".cache")}
     load0 = os.getloadavg()[0]
     t0 = time.perf_counter()
+    report = cwd / "rusage.json"
     with open(cwd / "stdout.txt", "w") as out, open(cwd / "stderr.txt", "w") as err:
-        proc = subprocess.Popen(argv, cwd=cwd, stdout=out, stderr=err, env=env)
-        _, status, usage = os.wait4(proc.pid, 0)
+        subprocess.run([sys.executable, "-c", LAUNCHER, str(report), *argv], cwd=cwd,
+                       stdout=out, stderr=err, env=env, check=True)
     wall = time.perf_counter() - t0
-    return {"exit": os.waitstatus_to_exitcode(status), "wall_s": round(wall, 2),
-            "peak_rss_bytes": usage.ru_maxrss * 1024, "load_before": round(load0, 2),
+    usage = json.loads(report.read_text())
+    return {"exit": usage["exit"], "wall_s": round(wall, 2),
+            "peak_rss_bytes": usage["maxrss_kb"] * 1024, "load_before": round(load0, 2),
             "load_after": round(os.getloadavg()[0], 2),
             "stdout": (cwd / "stdout.txt").read_text()[-2000:],
             "stderr": (cwd / "stderr.txt").read_text()[-2000:]}

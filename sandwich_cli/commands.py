@@ -116,7 +116,7 @@ def _guard(scenes: list[Scene], models: tuple[str, ...], args: argparse.Namespac
                                    label=label)
             if verdict.refusal is not None:
                 problems.append(verdict.refusal)
-            elif verdict.warning is not None:
+            elif verdict.warning is not None and mpi_rank() == 0:
                 print(f"warning: {where or scene.source}: {verdict.warning}", file=sys.stderr)
     if problems:
         raise SceneError(problems)

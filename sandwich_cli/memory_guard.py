@@ -56,7 +56,7 @@ def check_memory(scene: Scene, what: str, options: Mapping[str, str] | None = No
         return MemoryVerdict()
     try:
         est = memory.estimate(scene, what)
-    except ValueError:  # a layout the mesher refuses: it says why itself
+    except (ValueError, ArithmeticError):  # a layout the mesher refuses: it says why itself
         return MemoryVerdict()
     options = options or {}
     need = est.peak_bytes * copies

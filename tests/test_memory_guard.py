@@ -9,8 +9,6 @@ The constants of the estimate are checked against the measurements they were fit
 
 import dataclasses
 import glob
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -153,44 +151,47 @@ def test_a_study_whose_cases_cannot_fit_is_refused(tmp_path, monkeypatch, capsys
     assert "or the workers" in err and not out.exists()
 
 
-def test_the_constants_are_those_fitted_to_the_stored_measurements():
+def _benchmark():
+    """``benchmarks/memory_guard.py`` as a module (its fit, its rows, its measuring launcher)."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
     try:
         import memory_guard
     finally:
         sys.path.remove(str(ROOT / "benchmarks"))
+    return memory_guard
+
+
+def test_the_constants_are_those_fitted_to_the_stored_measurements():
     import json
 
+    bench = _benchmark()
     rows = json.loads((ROOT / "benchmarks" / "results" / "memory" / "memory_guard.json")
                       .read_text())["rows"]
-    roles = {memory_guard._row_id(r): r for r in rows}
-    assert all(r.get("role") for r in roles.values())
-    fitted = memory_guard.fit(rows)
+    assert all(r.get("role") for r in rows)
+    fitted = bench.fit(rows)
     for name, value in fitted.items():
         assert getattr(memory, name) == pytest.approx(value, rel=0.01), name
     for r in rows:  # every measured row, fitted or predicted, within a factor 1.25
         if r["kind"] != "import":
             kept = (r["steps"] or 0) + 1 if r["kind"] != "2d-mesh" else None
-            ratio = memory_guard.estimate_of(r, kept) / r["peak_rss_bytes"]
+            ratio = bench.estimate_of(r, kept) / r["peak_rss_bytes"]
             if r.get("core") == "auto":  # an upper bound: every element at the cap (1.94 here)
                 assert 1.0 < ratio < 2.0, ratio
             else:
-                assert 1 / 1.25 < ratio < 1.25, (memory_guard._row_id(r), ratio)
+                assert 1 / 1.25 < ratio < 1.25, (bench._row_id(r), ratio)
 
 
 def test_a_small_real_beam_run_is_within_a_factor_2_of_its_estimate(tmp_path):
     """Measured here: peak RSS of a real solve (its own process) against the estimate."""
-    scene = _scene_with(tmp_path, "\n[beam_model]\nelements = 600\ncore = 3\n")
-    scene.write_text(scene.read_text().replace("value = -8", "value = -0.1"))
-    proc = subprocess.Popen([sys.executable, "-m", "sandwich_cli", "solve", str(scene),
-                             "--model", "beam", "--out", str(tmp_path / "o"), "--quiet"],
-                            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            env={**os.environ})
-    _, status, usage = os.wait4(proc.pid, 0)
-    assert os.waitstatus_to_exitcode(status) == 0
     import json
 
+    scene = _scene_with(tmp_path, "\n[beam_model]\nelements = 600\ncore = 3\n")
+    scene.write_text(scene.read_text().replace("value = -8", "value = -0.1"))
+    run = _benchmark().measure([sys.executable, "-m", "sandwich_cli", "solve", str(scene),
+                                "--model", "beam", "--out", str(tmp_path / "o"), "--quiet"],
+                               tmp_path)
+    assert run["exit"] == 0, run["stderr"]
     steps = json.loads((tmp_path / "o" / "summary.json").read_text())["steps"]
     est = memory.estimate(load_scene(scene), "beam", states=steps + 1).peak_bytes
-    ratio = est / (usage.ru_maxrss * 1024)
+    ratio = est / run["peak_rss_bytes"]
     assert 0.5 < ratio < 2.0, ratio
