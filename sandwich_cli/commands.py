@@ -363,7 +363,7 @@ def _guard_study(study, workers: int, args: argparse.Namespace) -> None:
         if not sizes:
             continue
         _, worst = max(sizes, key=lambda t: t[0])
-        copies = min(workers, len(cases) if what == study.model else study.check)
+        copies = min(workers, len(study.cases) if what == study.model else study.check)
         _guard([worst.scene], (what,), args, copies=copies, where=str(study.source),
                label=f"case {worst.index}" + (" (its 2D check)" if what != study.model else ""))
 
