@@ -11,7 +11,7 @@ RSS measured by ``benchmarks/memory_guard.py`` on ``scenes/default.toml``
 - **beam**: ``BEAM_BASE + BEAM_PER_WORK · elements · z · d`` where, at the core level ℓ the
   solve may build (:func:`beam_level`), ``z`` is the number of Gauss points through the core and
   ``d`` the DOFs of an element (both from :mod:`beam_element.core_basis`): the element arrays the
-  vectorised assembly holds at once scale with their product (measured: 1.0 ± 0.1 of the peak at
+  vectorised assembly holds at once scale with their product (measured: 0.93–1.13 of the peak at
   levels 1, 3, 4 and 5). Plus every converged state the path keeps (``8 · DOFs`` bytes each,
   ``analysis.max_steps`` of them at most; twice for ``"auto"``, which keeps the pass it checks).
 - **2D solve**: ``TWO_D_BASE + TWO_D_PER_DOF · n · log2(n)`` for ``n`` DOFs (the MUMPS LDLᵀ factor
@@ -35,12 +35,12 @@ GB = 1e9
 STATE_BYTES_PER_DOF = 8.0  # a kept converged state: its float64 displacement vector
 
 # Fitted by benchmarks/memory_guard.py (benchmarks/results/memory/memory_guard.md)
-BEAM_BASE = 229.4e6  # bytes
+BEAM_BASE = 204.6e6  # bytes
 BEAM_PER_WORK = 194.0  # bytes per element, core Gauss point and element DOF
-TWO_D_BASE = 180.8e6  # bytes
-TWO_D_PER_DOF = 186.9  # bytes per DOF and log2(DOFs)
-MESH_BASE = 92.66e6  # bytes
-MESH_PER_CELL = 1699.0  # bytes per cell
+TWO_D_BASE = 169.0e6  # bytes
+TWO_D_PER_DOF = 189.5  # bytes per DOF and log2(DOFs)
+MESH_BASE = 92.61e6  # bytes
+MESH_PER_CELL = 1736.0  # bytes per cell
 
 
 @dataclass(frozen=True)
