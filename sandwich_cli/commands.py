@@ -1,7 +1,9 @@
 """The ``sandwich`` command: validate | mesh | solve | compare | gallery | demo | study.
 
 Every command refuses a bad scene, bad option or unusable output folder before any work (exit
-code 2, one line per problem naming the file or option, the key and the reason). A solve that
+code 2, one line per problem naming the file or option, the key and the reason), and so does
+every command that solves or meshes for a run estimated not to fit in the memory available
+(:mod:`sandwich_cli.memory_guard`). A solve that
 stops before its target, or is interrupted (Ctrl-C, SIGTERM), keeps and writes every converged
 step and exits with code 1 after saying where and why.
 
@@ -40,7 +42,8 @@ examples:
   sandwich study studies/shipped/fig5-knockdown.toml --workers 2
 
 exit codes: 0 done, 1 stopped before the target or interrupted (converged steps written),
-2 bad input (scene, option or output folder; nothing solved), 3 internal error (crash log named)
+2 bad input (scene, option, output folder, or a run estimated not to fit in the memory
+available; nothing solved), 3 internal error (crash log named)
 """
 # Loggers of the FEniCSx stack: their warnings and the JIT compiler's INFO lines are shown only
 # with --verbose (the 2D model's first run compiles its forms)
