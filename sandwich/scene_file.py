@@ -20,6 +20,9 @@ def load_scene(path: str | Path) -> Scene:
     """
     path = Path(path)
     fname = str(path)
+    if "\0" in fname:  # the system cannot take it (Python raises ValueError)
+        raise SceneError([Problem(fname.replace("\0", "\\0"), "-",
+                                  "cannot be read (a NUL character in the file name)")])
     try:
         mode = path.stat().st_mode
     except FileNotFoundError:

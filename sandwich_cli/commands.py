@@ -1,7 +1,9 @@
 """The ``sandwich`` command: validate | mesh | solve | compare | gallery | demo | study.
 
 Every command refuses a bad scene, bad option or unusable output folder before any work (exit
-code 2, one line per problem naming the file or option, the key and the reason). A solve that
+code 2, one line per problem naming the file or option, the key and the reason), and so does
+every command that solves or meshes for a run estimated not to fit in the memory available
+(:mod:`sandwich_cli.memory_guard`). A solve that
 stops before its target, or is interrupted (Ctrl-C, SIGTERM), keeps and writes every converged
 step and exits with code 1 after saying where and why.
 
@@ -26,6 +28,7 @@ from sandwich.quiet_logs import hush_libraries, unhush_libraries
 from sandwich.results import OutputError, check_output_folder
 from sandwich.scene import MESH_LEVELS, Scene, SceneError
 from sandwich.scene_file import load_scene
+from sandwich_cli.memory_guard import check_memory
 
 EXIT_OK, EXIT_STOPPED, EXIT_BAD_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
 EXAMPLES = """units: N, mm, MPa (scene files); load factor λ multiplies every load's force
@@ -39,7 +42,8 @@ examples:
   sandwich study studies/shipped/fig5-knockdown.toml --workers 2
 
 exit codes: 0 done, 1 stopped before the target or interrupted (converged steps written),
-2 bad input (scene, option or output folder; nothing solved), 3 internal error (crash log named)
+2 bad input (scene, option, output folder, or a run estimated not to fit in the memory
+available; nothing solved), 3 internal error (crash log named)
 """
 # Loggers of the FEniCSx stack: their warnings and the JIT compiler's INFO lines are shown only
 # with --verbose (the 2D model's first run compiles its forms)
@@ -99,6 +103,28 @@ def _overridden(scene: Scene, model: str, args: argparse.Namespace) -> Scene:
     return with_options(scene, "beam", elements=elements)
 
 
+CLI_KEYS = {"elements": "beam_model.elements", "refine": "reference2d.refine",
+            "level": "reference2d.level"}  # option -> the scene key it overrides
+
+
+def _guard(scenes: list[Scene], models: tuple[str, ...], args: argparse.Namespace, *,
+           copies: int = 1, where: str | None = None, label: str = "") -> None:
+    """Refuse before any work a run estimated not to fit in memory; warn when it is close."""
+    given = {key: f"--{opt}" for opt, key in CLI_KEYS.items()
+             if getattr(args, opt, None) is not None}
+    problems = []
+    for scene in scenes:
+        for model in models:
+            verdict = check_memory(scene, model, given, copies=copies, where=where,
+                                   label=label)
+            if verdict.refusal is not None:
+                problems.append(verdict.refusal)
+            elif verdict.warning is not None and mpi_rank() == 0:
+                print(f"warning: {where or scene.source}: {verdict.warning}", file=sys.stderr)
+    if problems:
+        raise SceneError(problems)
+
+
 def cmd_validate(args: argparse.Namespace) -> int:
     """Check scene files and say which are usable."""
     for s in _load(args.scenes):
@@ -111,6 +137,7 @@ def cmd_mesh(args: argparse.Namespace) -> int:
     """Mesh a scene for the 2D reference and print a quality report."""
     (scene,) = _load([args.scene])
     scene = _overridden(scene, "2d", args)
+    _guard([scene], ("mesh",), args)
     out = Path(args.out) if args.out else RESULTS / scene.name / "mesh"
     check_output_folder(out)
     from meshes import build_mesh, quality_report, write_mesh
@@ -165,6 +192,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
     (scene,) = _load([args.scene])
     scene = _overridden(scene, args.model, args)
+    _guard([scene], (args.model,), args)
     out = Path(args.out) if args.out else default_out(scene, args.model)
     check_output_folder(out)
     for line in warnings_before_solve(scene, args.model):
@@ -202,6 +230,7 @@ def _compare_and_report(args: argparse.Namespace, scene: Scene, out: Path,
     from comparisons import compare
     from models import text_progress
 
+    _guard([scene], tuple(MODELS), args)
     check_output_folder(out)
     progress = None if args.quiet else text_progress()
     try:
@@ -249,6 +278,7 @@ def cmd_gallery(args: argparse.Namespace) -> int:
         print(f"gallery: no scene matches {args.scenes}", file=sys.stderr)
         return EXIT_BAD_INPUT
     scenes = _load(paths)
+    _guard(scenes, tuple(MODELS), args)
     out = Path(args.out) if args.out else RESULTS / "gallery"
     check_output_folder(out)
     try:
@@ -293,6 +323,8 @@ def cmd_study(args: argparse.Namespace) -> int:
     if args.workers is not None and not 1 <= args.workers <= WORKERS_MAX:
         raise UsageError(f"option --workers: must be between 1 and {WORKERS_MAX}, "
                          f"got {args.workers}")
+    if args.scheduler is None:  # a cluster's memory is not this machine's to judge
+        _guard_study(study, args.workers or 2, args)
     out = Path(args.out) if args.out else RESULTS / "studies" / study.name
     check_output_folder(out)
     _say(args, f"{study.name}: {len(study.cases)} case(s), model {study.model}"
@@ -310,6 +342,33 @@ def cmd_study(args: argparse.Namespace) -> int:
         print(f"{failed} case(s) failed (reasons in {result.table})", file=sys.stderr)
         return EXIT_STOPPED
     return EXIT_OK
+
+
+STUDY_2D_SAMPLE = 400
+
+
+def _guard_study(study, workers: int, args: argparse.Namespace) -> None:
+    """The memory guard on a study's largest case, ``workers`` of them at once (and its checks)."""
+    from models import memory
+
+    whats = (study.model,) + (("2d",) if study.check and study.model != "2d" else ())
+    for what in whats:
+        # every case's beam estimate is arithmetic; a 2D one lays the mesh out (~5 ms): at most
+        # STUDY_2D_SAMPLE cases evenly spread are laid out
+        cases = study.cases if what == "beam" else \
+            study.cases[::max(1, len(study.cases) // STUDY_2D_SAMPLE)]
+        try:
+            if what == "2d" and study.max_cells is not None:  # larger meshes are not run
+                cases = [c for c in cases if memory.mesh_size(c.scene)[0] <= study.max_cells]
+            sizes = [(memory.estimate(c.scene, what).peak_bytes, c) for c in cases]
+        except (ValueError, KeyError):  # a layout the mesher refuses says why when it runs
+            continue
+        if not sizes:
+            continue
+        _, worst = max(sizes, key=lambda t: t[0])
+        copies = min(workers, len(study.cases) if what == study.model else study.check)
+        _guard([worst.scene], (what,), args, copies=copies, where=str(study.source),
+               label=f"case {worst.index}" + (" (its 2D check)" if what != study.model else ""))
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -112,6 +112,9 @@ def case_key(scene: Scene, model: str, options: dict[str, Any]) -> str:
 
 def _read_toml(path: Path, what: str) -> dict[str, Any]:
     fname = str(path)
+    if "\0" in fname:  # the system cannot take it (Python raises ValueError)
+        raise StudyError([Problem(fname.replace("\0", "\\0"), "-",
+                                  "cannot be read (a NUL character in the file name)")])
     try:
         mode = path.stat().st_mode
     except OSError as exc:

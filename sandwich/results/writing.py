@@ -32,6 +32,7 @@ from sandwich.results.tractions import scene_tips, tip_tractions_csv
 from sandwich.results.types import PROFILE_COLUMNS, FieldFrame, Solution
 from sandwich.results.vtu import pvd_text, vtu_text
 
+NAME_MAX = 255  # bytes of one file or folder name (Linux file systems)
 RESULT_SET_NAMES = frozenset({"history.csv", "profiles.csv", "summary.json", "fields.pvd",
                               "tip_tractions.csv"})
 
@@ -211,20 +212,32 @@ def check_output_folder(folder: Path) -> None:
     """Refuse, before any work, a folder that cannot take a result set.
 
     Raises :class:`OutputError` when ``folder`` (or its nearest existing parent) is a file, or
-    is not writable.
+    is not writable, or when its name cannot be a folder (a NUL character, a name longer than
+    :data:`NAME_MAX` bytes).
     """
     folder = Path(folder)
-    if folder.exists() and not folder.is_dir():
-        raise OutputError(f"{folder}: exists and is not a folder")
-    probe = folder
-    while not probe.exists():
-        if probe.parent == probe:
-            break
-        probe = probe.parent
+    if "\0" in str(folder):  # the system cannot take it (Python raises ValueError)
+        shown = str(folder).replace("\0", "\\0")
+        raise OutputError(f"{shown}: cannot name a folder (a NUL character)")
+    try:
+        if folder.exists() and not folder.is_dir():
+            raise OutputError(f"{folder}: exists and is not a folder")
+        probe = folder
+        while not probe.exists():
+            if probe.parent == probe:
+                break
+            probe = probe.parent
+    except OSError as exc:  # a name too long, a symlink loop, an I/O error
+        raise OutputError(f"{folder}: cannot be used as a folder ({exc.strerror or exc})"
+                          ) from None
     if not probe.is_dir():
         raise OutputError(f"{folder}: {probe} is not a folder")
     if not os.access(probe, os.W_OK | os.X_OK):
         raise OutputError(f"{folder}: {probe} is not writable")
+    for part in folder.parts:  # a name the folder's file system would refuse when writing
+        if len(os.fsencode(part)) > NAME_MAX:
+            raise OutputError(f"{folder}: a name of {len(os.fsencode(part))} bytes is longer "
+                              f"than the {NAME_MAX} a folder name may have")
 
 
 def _umask() -> int:

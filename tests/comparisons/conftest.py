@@ -3,6 +3,7 @@
 The synthetic solutions themselves are in ``cmp_synthetic.py`` (a plain module the tests import).
 """
 
+import dataclasses
 import shutil
 from pathlib import Path
 from types import SimpleNamespace
@@ -21,6 +22,7 @@ from cmp_synthetic import (
     scene_copy,
 )
 
+from models import registry
 from sandwich.scene_file import load_scene
 
 
@@ -44,3 +46,14 @@ def synth():
                            fake_solvers=fake_solvers,
                            analytic_limit=analytic_limit, load_of=load_of, K=K, C=C,
                            W_END=W_END, TIPS=TIPS)
+
+
+@pytest.fixture
+def fake_models(monkeypatch, synth):
+    """Registry models answering with the synthetic solutions; returns the list of calls."""
+    calls = []
+    solvers = synth.fake_solvers(0.03, calls=calls)
+    for name in ("beam", "2d"):
+        monkeypatch.setitem(registry.MODELS, name,
+                            dataclasses.replace(registry.MODELS[name], solve=solvers[name]))
+    return calls
