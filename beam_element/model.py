@@ -37,6 +37,7 @@ from beam_element.fracture import beam_tips, release_columns
 from beam_element.layer_operators import (
     LayerOperators,
     build_core_operators,
+    build_face_operators,
     build_layer_operators,
 )
 from beam_element.loads import patch_load, point_load, probe_row
@@ -88,9 +89,15 @@ def core_groups(
     element_dofs: np.ndarray,
     n_nodes: int,
     make_op: object,
+    stride: int | None = None,
+    offset: int = 0,
 ) -> list[CoreGroup]:
-    """Group core elements by level; extended DOFs = paper 40, then each node's enrichment."""
-    m = 4 * basis.count(basis.max_level)  # enrichment DOFs per node in the full vector
+    """Group core elements by level; extended DOFs = paper 40, then each node's enrichment.
+
+    ``stride``: extra DOFs per node in the full vector (default: the core enrichment's);
+    ``offset``: where the core enrichment starts in a node's block (after the face stretch).
+    """
+    m = 4 * basis.count(basis.max_level) if stride is None else stride
     groups = []
     for level in np.unique(element_levels):
         els = np.flatnonzero(element_levels == level)
@@ -98,7 +105,8 @@ def core_groups(
         k = len(mode_dofs(basis, int(level)))
         ext = [element_dofs[els]]
         for node in (0, 1):
-            ext.append(NODE_DOFS * n_nodes + m * (els + node)[:, None] + np.arange(k)[None, :])
+            ext.append(NODE_DOFS * n_nodes + m * (els + node)[:, None] + offset
+                       + np.arange(k)[None, :])
         ext_dofs = np.concatenate(ext, axis=1)
         groups.append(CoreGroup(level=int(level), elements=els, op=op,
                                 products=geometric_products(op), dofs=ext_dofs[:, op.dofs]))
@@ -125,6 +133,8 @@ class BeamModel:
     element_levels: np.ndarray | None = None  # core level of every element
     # debond tips (beam_element.fracture.BeamTip) whose G every accepted path state carries
     fracture_tips: list = field(default_factory=list)
+    # full DOFs of each face's element family when the faces carry their stretch DOF
+    face_dofs: dict | None = None
     pattern: ReducedPattern = field(init=False)
     committed: dict[str, ContactSummary] = field(default_factory=dict)
     max_penetration_seen: float = 0.0
@@ -143,12 +153,18 @@ class BeamModel:
         if self.element_levels is None:
             self.element_levels = np.ones(self.mesh.n_elements, dtype=int)
         # Block families: top face, core groups by level, bottom face, contact groups.
-        self.block_dofs = [self.element_dofs[:, self.layers["top"].dofs]]
+        faces = self.face_dofs or {n: self.element_dofs[:, self.layers[n].dofs]
+                                   for n in ("top", "bottom")}
+        self.block_dofs = [faces["top"]]
         self.block_dofs += [g.dofs for g in self.core]
-        self.block_dofs += [self.element_dofs[:, self.layers["bottom"].dofs]]
+        self.block_dofs += [faces["bottom"]]
         self.block_dofs += [p.block_dofs for p in self.pairs]
         self.pattern = reduced_pattern(self.block_dofs, self.dof_map)
         self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
+
+    def face_family_dofs(self, face: str) -> np.ndarray:
+        """Full DOF indices of ``face``'s element family, shape ``(E, n)`` in its rows' order."""
+        return self.block_dofs[0 if face == "top" else len(self.core) + 1]
 
     # --- DiscreteSystem -------------------------------------------------------------------
     @property
@@ -501,6 +517,7 @@ def build_model(
     contact_reach: float = DEFAULT_REACH,
     core_level: int | np.ndarray | None = None,
     core_basis: str = "sublayers",
+    face_stretch: bool = False,
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -547,6 +564,11 @@ def build_model(
         :mod:`beam_element.core_levels`); default 1, the paper's core.
     core_basis
         Enrichment family of levels > 1: ``"sublayers"`` (default) or ``"polynomial"``.
+    face_stretch
+        ``False`` (default, the paper's faces): a face's w is constant through its thickness.
+        ``True``: each face gets a stretch DOF per node
+        (:func:`~beam_element.layer_operators.build_face_operators`), so that a rotated face
+        bends as stiffly as an unrotated one; stored first in each node's extra block.
     """
     if face_membrane not in FACE_MEMBRANES:
         raise ValueError(f"face_membrane must be one of {FACE_MEMBRANES}, got {face_membrane!r}")
@@ -564,9 +586,17 @@ def build_model(
                  "core": core_stiffness(scene.core.material),
                  "bottom": face_stiffness(scene.bottom.material)}
     thickness = {"top": ht, "core": hc, "bottom": hb}
-    layers = {n: build_layer_operators(
-        n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n],
-        membrane_average=(n != "core" and face_membrane == "averaged")) for n in LAYERS}
+    if face_stretch:  # the face's through-thickness modulus, uncoupled (σ_z = E ε_z)
+        for n in ("top", "bottom"):
+            stiffness[n] = stiffness[n].copy()
+            stiffness[n][1, 1] = stiffness[n][0, 0]
+    layers = {"core": build_layer_operators("core", hc, z_bottom["core"], stiffness["core"],
+                                            gauss=orders["core"])}
+    for n in ("top", "bottom"):
+        layers[n] = build_face_operators(n, thickness[n], z_bottom[n], stiffness[n],
+                                         gauss=orders[n],
+                                         membrane_average=face_membrane == "averaged",
+                                         stretch=face_stretch)
     products = {n: geometric_products(op) for n, op in layers.items()}
     levels = np.broadcast_to(np.asarray(1 if core_level is None else core_level, dtype=int),
                              (mesh.n_elements,)).copy()
@@ -575,20 +605,34 @@ def build_model(
     basis = CoreBasis(core_basis, int(levels.max()))
     groups: list[CoreGroup] = []
     m = 4 * basis.count(basis.max_level)
+    fs = 2 if face_stretch else 0  # face stretch DOFs per node (top, bottom), first in the block
+    e = np.arange(mesh.n_elements)[:, None]
     if basis.max_level > 1:
-        e = np.arange(mesh.n_elements)[:, None]
         groups = core_groups(
             basis, levels, NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :], mesh.n_nodes,
             lambda level: build_core_operators(hc, z_bottom["core"], stiffness["core"], basis,
-                                               level, gauss=orders["core"]))
+                                               level, gauss=orders["core"]),
+            stride=m + fs, offset=fs)
     mode_active = (np.arange(m)[None, :]
                    < 4 * np.array([basis.count(int(k)) for k in node_levels(levels)])[:, None])
+    face_dofs = None
+    if face_stretch:
+        mode_active = np.concatenate([np.ones((mesh.n_nodes, 2), dtype=bool), mode_active], 1)
+        paper = NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :]
+        face_dofs = {}
+        for j, n in enumerate(("top", "bottom")):
+            ext = NODE_DOFS * mesh.n_nodes + (m + fs) * (e + np.arange(2)[None, :]) + j
+            face_dofs[n] = np.concatenate([paper, ext], axis=1)[:, layers[n].dofs]
 
     tol = 1e-9 * scene.length
     bonded = {i: np.array([scene.is_bonded(i, float(x), tol) for x in mesh.x])
               for i in ("top", "bottom")}
     supports = [NodeSupport(mesh.node_at(s.x, 1e-6 * scene.length), face, s.type)
                 for s in scene.supports for face in s.faces]
+    if face_stretch:  # a clamp holds the face's whole end section: no thickness change there
+        for s in supports:
+            if s.type == "clamp":
+                mode_active[s.node, ("top", "bottom").index(s.face)] = False
     dof_map = build_dof_map(mesh.n_nodes, bonded, supports, mode_active)
 
     f_ref = np.zeros(NODE_DOFS * mesh.n_nodes)
@@ -615,6 +659,7 @@ def build_model(
         dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,
         probe_rows=probes, face_thickness={"top": ht, "bottom": hb},
         smoothing=float(contact_smoothing), core=groups, element_levels=levels,
+        face_dofs=face_dofs,
     )
     model.fracture_tips = beam_tips(scene, model)
     return model
