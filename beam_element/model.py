@@ -40,7 +40,14 @@ from beam_element.layer_operators import (
     build_face_operators,
     build_layer_operators,
 )
-from beam_element.loads import patch_load, point_load, probe_row
+from beam_element.loads import (
+    patch_load,
+    point_load,
+    probe_row,
+    stretch_patch_load,
+    stretch_point_load,
+    stretch_row,
+)
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.scene import FACE_MEMBRANES, GRADINGS, BeamModelOptions
@@ -161,6 +168,11 @@ class BeamModel:
         self.block_dofs += [p.block_dofs for p in self.pairs]
         self.pattern = reduced_pattern(self.block_dofs, self.dof_map)
         self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
+
+    @property
+    def face_extra(self) -> int:
+        """Face stretch DOFs per node at the head of each node's extra block (0 or 2)."""
+        return 0 if self.face_dofs is None else 2
 
     def face_family_dofs(self, face: str) -> np.ndarray:
         """Full DOF indices of ``face``'s element family, shape ``(E, n)`` in its rows' order."""
@@ -517,7 +529,7 @@ def build_model(
     contact_reach: float = DEFAULT_REACH,
     core_level: int | np.ndarray | None = None,
     core_basis: str = "sublayers",
-    face_stretch: bool = False,
+    face_stretch: bool | None = None,
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -565,14 +577,17 @@ def build_model(
     core_basis
         Enrichment family of levels > 1: ``"sublayers"`` (default) or ``"polynomial"``.
     face_stretch
-        ``False`` (default, the paper's faces): a face's w is constant through its thickness.
+        ``False`` (the paper's faces): a face's w is constant through its thickness.
         ``True``: each face gets a stretch DOF per node
         (:func:`~beam_element.layer_operators.build_face_operators`), so that a rotated face
         bends as stiffly as an unrotated one; stored first in each node's extra block.
+        Default: the scene's ``[beam_model] faces`` (``"stretch"`` unless it says ``"paper"``).
     """
     if face_membrane not in FACE_MEMBRANES:
         raise ValueError(f"face_membrane must be one of {FACE_MEMBRANES}, got {face_membrane!r}")
     options = getattr(scene, "beam_model", None)
+    if face_stretch is None:
+        face_stretch = getattr(options, "faces", BeamModelOptions.faces) == "stretch"
     if elements is None:
         elements = getattr(options, "elements", BeamModelOptions.elements)
     mesh = beam_mesh(scene, elements, grading=grading, growth=growth, size_ratio=size_ratio)
@@ -641,9 +656,20 @@ def build_model(
             f_ref += point_load(mesh, load.on, load.x, load.force)
         else:
             f_ref += patch_load(mesh, load.on, *load.span, load.force)
-    f_ref = np.concatenate([f_ref, np.zeros(mode_active.size)])  # no load on the enrichment
-    probes = {p.name: np.concatenate([probe_row(mesh, p.on, p.x), np.zeros(mode_active.size)])
-              for p in scene.probes}
+    extra = np.zeros(mode_active.shape)  # no load on the core enrichment
+    if face_stretch:  # loads act on the faces' outer surfaces: they work on d too
+        for load in scene.loads:
+            j = ("top", "bottom").index(load.on)
+            extra[:, j] += (stretch_point_load(mesh, load.x, load.force) if load.width == 0
+                            else stretch_patch_load(mesh, *load.span, load.force))
+    f_ref = np.concatenate([f_ref, extra.ravel()])
+    probes = {}
+    for p in scene.probes:  # w of the face's mid-surface (where the 2D model reads it)
+        extra = np.zeros(mode_active.shape)
+        if face_stretch:
+            nodes, weights = stretch_row(mesh, p.x)
+            extra[nodes, ("top", "bottom").index(p.on)] = 0.5 * weights
+        probes[p.name] = np.concatenate([probe_row(mesh, p.on, p.x), extra.ravel()])
 
     pairs = [group for i in ("top", "bottom") if np.any(~bonded[i])
              for group in contact_pair_groups(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width,

@@ -212,7 +212,9 @@ def run(
     bm = scene.beam_model
     options = {"grading": getattr(bm, "grading", "graded"),
                "face_membrane": getattr(bm, "face_membrane", "paper"),
-               "core_basis": getattr(bm, "core_basis", "sublayers"), **(model_options or {})}
+               "core_basis": getattr(bm, "core_basis", "sublayers"),
+               "face_stretch": getattr(bm, "faces", "stretch") == "stretch",
+               **(model_options or {})}
     choice = choose_core_levels(scene, elements, options)
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []
@@ -320,6 +322,7 @@ def run(
     solution.extra.update(_growth_summary(scene, solution))
     if level_warning(model, beam_tips(scene, model)):
         solution.extra["G_warning"] = level_warning(model, beam_tips(scene, model))
+    solution.extra["faces"] = "stretch" if options["face_stretch"] else "paper"
     solution.extra["core"] = {
         "how": choice.how, "basis": options["core_basis"],
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,

@@ -15,6 +15,7 @@ from sandwich.scene import (
     ANALYSIS_KINDS,
     CONTROLS,
     CORE_BASES,
+    FACE_KINEMATICS,
     FACE_MEMBRANES,
     FACES,
     GRADINGS,
@@ -475,7 +476,7 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     key = "beam_model"
-    t = r.table(tbl, key, ("elements", "grading", "face_membrane", "gauss_x", "gauss_z",
+    t = r.table(tbl, key, ("elements", "grading", "face_membrane", "faces", "gauss_x", "gauss_z",
                            "contact_penalty", "profile_every", "core", "core_basis", "tolerance",
                            "max_core_level", "core_zones"))
     if t is None:
@@ -519,6 +520,7 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
         or d.grading,
         face_membrane=r.choice(t, "face_membrane", key, FACE_MEMBRANES,
                                default=d.face_membrane) or d.face_membrane,
+        faces=r.choice(t, "faces", key, FACE_KINEMATICS, default=d.faces) or d.faces,
         gauss_x=r.integer(t, "gauss_x", key, default=None, lo=2, hi=12),
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
