@@ -524,8 +524,8 @@ def build_model(
     grading: str = "graded",
     growth: float = DEFAULT_GROWTH,
     size_ratio: float = DEFAULT_SIZE_RATIO,
-    face_membrane: str = "paper",
-    contact_search: str = "same-x",
+    face_membrane: str | None = None,
+    contact_search: str | None = None,
     contact_reach: float = DEFAULT_REACH,
     core_level: int | np.ndarray | None = None,
     core_basis: str = "sublayers",
@@ -556,17 +556,18 @@ def build_model(
         ``"tips"`` grades towards the centres only (the default until 2026-11-22);
         ``"uniform"`` keeps one size.
     face_membrane
-        ``"paper"`` (default): the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"``
-        (option, departs from the paper): the faces' ε_x is its element mean along x (assumed
-        membrane strain; removes membrane locking, see docs/beam_vs_2d.md).
+        ``"paper"``: the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"`` (departs
+        from the paper): the faces' ε_x is its element mean along x (assumed membrane strain;
+        removes membrane locking, see docs/beam_vs_2d.md). Default: the scene's
+        ``[beam_model] face_membrane`` (``"averaged"``).
     contact_search
         Pairing on debonded stretches (:func:`~beam_element.contact.contact_pairs`):
-        ``"same-x"`` (default): each untied face node against the core point of the same x
-        (the paper's closest-node rule under small sliding); ``"closest-point"``: the node
-        projected on the deformed core boundary curve (node-to-segment, consistent
-        linearisation, continuous beyond the search reach, docs/contact_search.md). Not the
-        default: it costs 1.5-4x the wall time (fig. 5 at 480 elements would miss the 10 s
-        target) for a +0.5 % change of λ(−15) on fig. 5 and < 0.1 % on c3.
+        ``"same-x"`` (the paper's closest-node rule under small sliding): each untied face
+        node against the core point of the same x; ``"closest-point"``: the node projected on
+        the deformed core boundary curve (node-to-segment, consistent linearisation, continuous
+        beyond the search reach, docs/contact_search.md). Default: the scene's
+        ``[beam_model] contact_search`` (``"closest-point"``: with the faces' stretch and core
+        levels ≥ 3 the same-x pairing stalls on fig. 5, docs/beam_vs_2d.md).
     contact_reach
         Closest-point search: the segments within this distance (mm) on each side of a node, at
         least one per side, are searched (default ``DEFAULT_REACH``).
@@ -583,9 +584,13 @@ def build_model(
         bends as stiffly as an unrotated one; stored first in each node's extra block.
         Default: the scene's ``[beam_model] faces`` (``"stretch"`` unless it says ``"paper"``).
     """
+    options = getattr(scene, "beam_model", None)
+    if face_membrane is None:
+        face_membrane = getattr(options, "face_membrane", BeamModelOptions.face_membrane)
+    if contact_search is None:
+        contact_search = getattr(options, "contact_search", BeamModelOptions.contact_search)
     if face_membrane not in FACE_MEMBRANES:
         raise ValueError(f"face_membrane must be one of {FACE_MEMBRANES}, got {face_membrane!r}")
-    options = getattr(scene, "beam_model", None)
     if face_stretch is None:
         face_stretch = getattr(options, "faces", BeamModelOptions.faces) == "stretch"
     if elements is None:

@@ -211,7 +211,8 @@ def run(
         raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
     bm = scene.beam_model
     options = {"grading": getattr(bm, "grading", "graded"),
-               "face_membrane": getattr(bm, "face_membrane", "paper"),
+               "face_membrane": getattr(bm, "face_membrane", "averaged"),
+               "contact_search": getattr(bm, "contact_search", "closest-point"),
                "core_basis": getattr(bm, "core_basis", "sublayers"),
                "face_stretch": getattr(bm, "faces", "stretch") == "stretch",
                **(model_options or {})}
@@ -323,6 +324,8 @@ def run(
     if level_warning(model, beam_tips(scene, model)):
         solution.extra["G_warning"] = level_warning(model, beam_tips(scene, model))
     solution.extra["faces"] = "stretch" if options["face_stretch"] else "paper"
+    solution.extra["face_membrane"] = options["face_membrane"]
+    solution.extra["contact_search"] = options["contact_search"]
     solution.extra["core"] = {
         "how": choice.how, "basis": options["core_basis"],
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,

@@ -13,10 +13,12 @@ every resolution; wall times are measured here. The error of every run is taken 
 Writes ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` (error vs time, Pareto fronts)
 into ``benchmarks/results/comparisons/``.
 
-Beam variants: ``paper`` (the paper's element: core level 1), ``averaged`` (core level 1 with
-``face_membrane = "averaged"``, not the paper's, see docs/beam_vs_2d.md), ``L2``…``L6`` (every
-element at that core level, docs/beam_element.md "Core levels") and ``auto`` (``core = "auto"``,
-the scene default: levels from the error indicator, the path rerun to check them).
+Beam variants: ``paper`` (the paper's element: core level 1, ``faces = "paper"``), ``averaged``
+(the same with ``face_membrane = "averaged"``, not the paper's, see docs/beam_vs_2d.md),
+``L1``…``L6`` (every element at that core level, docs/beam_element.md "Core levels", with the
+default stretch faces) and ``auto`` (``core = "auto"``, the scene default: levels from the error
+indicator, the path rerun to check them); a suffix ``a`` on ``L<k>``/``auto`` adds
+``face_membrane = "averaged"`` (``L2a``, ``autoa``).
 ``--until NAME=VALUE`` ends a scene's path earlier (the fig4 2D core crushes at w ≈ −13 mm, so
 its path is compared to −12 mm). Wall and CPU seconds are both recorded: on a shared machine
 the CPU time is the steadier of the two.
@@ -71,17 +73,21 @@ class Run:
     cpu_seconds: float = math.nan
 
 
-VARIANTS = ("paper", "averaged", "L2", "L3", "L4", "L5", "L6", "auto")
+VARIANTS = ("paper", "averaged", "L1", "L2", "L3", "L4", "L5", "L6", "auto",
+            "L1a", "L2a", "L3a", "L4a", "autoa")
 
 
 def with_beam_elements(scene: Scene, n: int, variant: str = "paper") -> Scene:
     """``scene`` with ``n`` beam elements and the beam ``variant`` (see :data:`VARIANTS`)."""
     if variant in ("paper", "averaged"):
-        core, membrane = 1, variant
+        core, membrane, faces = 1, variant, "paper"
     else:
-        core, membrane = ("auto" if variant == "auto" else int(variant[1:])), "paper"
+        membrane = "averaged" if variant.endswith("a") else "paper"
+        name = variant.removesuffix("a")
+        core, faces = ("auto" if name == "auto" else int(name[1:])), "stretch"
     return dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, elements=n, face_membrane=membrane, core=core, core_zones=()))
+        scene.beam_model, elements=n, face_membrane=membrane, core=core, core_zones=(),
+        faces=faces))
 
 
 def with_until(scene: Scene, value: float) -> Scene:
