@@ -25,7 +25,7 @@ from beam_element.contact import (
     penalty_response,
 )
 from beam_element.core_basis import CoreBasis, mode_dofs
-from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
+from beam_element.dofs import ELEMENT_DOFS, NODE_DOFS
 from beam_element.element import (
     GeometricProducts,
     LayerState,

@@ -13,8 +13,8 @@ from typing import Any
 
 from sandwich.scene import (
     ANALYSIS_KINDS,
-    CONTROLS,
     CONTACT_SEARCHES,
+    CONTROLS,
     CORE_BASES,
     FACE_KINEMATICS,
     FACE_MEMBRANES,

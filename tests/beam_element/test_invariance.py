@@ -6,7 +6,8 @@ w = x sin θ + z(cos θ − 1) is represented exactly (strain-free). The paper's
 constant through their thickness (eq. 1b), so their γ = u,z + w,x + u,x u,z misses w,x w,z and
 equals (1 − cos θ) sin θ ≈ θ³/2: f_int = O(θ³), i.e. the force ratio when θ halves is 8. With
 the faces' stretch DOF (the default, ``[beam_model] faces = "stretch"``) w is linear through a
-face and d = t (cos θ − 1) makes the face's rotation exact too: f_int = 0 to round-off at any θ. Gauss orders: the energy is a polynomial whose degree fixes the exact
+face and d = t (cos θ − 1) makes the face's rotation exact too: f_int = 0 to round-off at any θ.
+Gauss orders: the energy is a polynomial whose degree fixes the exact
 rule (quadrature.py); raising the order must change f_int only at round-off.
 """
 
