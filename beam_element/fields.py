@@ -50,7 +50,7 @@ def sample_layer(
         families = [(g.op, g.elements, g.dofs) for g in model.core]
     else:
         families = [(model.layers[layer], np.arange(model.mesh.n_elements),
-                     model.element_dofs[:, model.layers[layer].dofs])]
+                     model.face_family_dofs(layer))]
     E, G = model.mesh.n_elements, eta.size
     out = {k: np.empty((E, G)) for k in ("x", "z", "u", "w", "sigma_x", "sigma_z", "tau")}
     for rows, els, dofs in families:

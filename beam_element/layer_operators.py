@@ -89,12 +89,16 @@ class LayerOperators:
     basis: CoreBasis | None = None
     level: int = 1
     u_mask: np.ndarray | None = None
+    stretch: bool = False
 
     def at(self, eta: np.ndarray, xi: np.ndarray) -> LayerOperators:
         """The same layer's rows at other points (weights set to zero)."""
         if self.basis is not None and self.level > 1:
             return build_core_operators(self.thickness, self.z_bottom, self.stiffness,
                                         self.basis, self.level, eta=eta, xi=xi)
+        if self.stretch:
+            return build_face_operators(self.name, self.thickness, self.z_bottom,
+                                        self.stiffness, eta=eta, xi=xi, stretch=True)
         return build_layer_operators(
             self.name, self.thickness, self.z_bottom, self.stiffness, eta=eta, xi=xi
         )
@@ -273,3 +277,55 @@ def build_core_operators(
         x_slope=np.concatenate([paper.x_slope, x_slope]), basis=basis, level=level,
         u_mask=np.concatenate([paper.u_columns, is_u]), **rows,
     )
+
+
+# Through-thickness shape of a face's stretch DOF: 0 at the face's inner surface (the one on the
+# core), 1 at its outer surface.
+FACE_OUTER = {"top": "L_t", "bottom": "L_b"}
+
+
+def build_face_operators(
+    name: str,
+    thickness: float,
+    z_bottom: float,
+    stiffness: np.ndarray,
+    *,
+    gauss: tuple[int, int] | None = None,
+    eta: np.ndarray | None = None,
+    xi: np.ndarray | None = None,
+    membrane_average: bool = False,
+    stretch: bool = False,
+) -> LayerOperators:
+    """Rows of a face: the paper's (eq. 13), optionally with the face's stretch DOF.
+
+    ``stretch=False`` is :func:`build_layer_operators` (the paper's face: w constant through
+    the thickness). ``stretch=True`` (not the paper's element) adds one w DOF per node,
+    d = w(outer surface) − w(inner surface), linear along x like the face's u and linear through
+    the thickness, zero at the inner surface: the face's w at the core is still the paper's w
+    DOF, so ties, contact, supports and probes are unchanged. With it a rotated face fibre can
+    stay straight, normal and unstretched (u,z = −sin θ, w,z = cos θ − 1); with w constant in z
+    it can only stay normal by stretching (u,z = −tan θ), which raises the face's bending
+    strain by 1/cos θ and its bending stiffness by 1/cos² θ at a rotation θ. The ε_z row of
+    ``stiffness`` must then hold the face's through-thickness modulus (σ_z = E ε_z, uncoupled:
+    no Poisson coupling, so no thickness locking in bending). The element vector is extended:
+    indices 0..39 are the paper's, then the stretch DOF at node 0 and node 1 (40, 41).
+    """
+    paper = build_layer_operators(name, thickness, z_bottom, stiffness, gauss=gauss, eta=eta,
+                                  xi=xi, membrane_average=membrane_average)
+    if not stretch:
+        return paper
+    if name not in FACE_OUTER:
+        raise ValueError(f"only a face has a stretch DOF, got {name!r}")
+    cols = {key: np.zeros((paper.eta.size, NODES_PER_ELEMENT))
+            for key in ("N", "N_eta", "N_xi", "M", "M_eta", "M_xi")}
+    Z, Z_xi = z_shape(FACE_OUTER[name], paper.xi)
+    for node in range(NODES_PER_ELEMENT):
+        X, X_eta = x_shape("L", node, paper.eta)
+        cols["M"][:, node], cols["M_eta"][:, node], cols["M_xi"][:, node] = (
+            X * Z, X_eta * Z, X * Z_xi)
+    rows = {key: np.concatenate([getattr(paper, key), cols[key]], axis=1) for key in cols}
+    return replace(
+        paper, dofs=np.concatenate([paper.dofs, ELEMENT_DOFS + np.arange(NODES_PER_ELEMENT)]),
+        x_slope=np.concatenate([paper.x_slope, np.zeros(NODES_PER_ELEMENT, dtype=bool)]),
+        u_mask=np.concatenate([paper.u_columns, np.zeros(NODES_PER_ELEMENT, dtype=bool)]),
+        stretch=True, **rows)

@@ -69,3 +69,40 @@ def probe_row(mesh: BeamMesh, face: str, x: float) -> np.ndarray:
     idx, val = hermite_w_row(mesh, face, x)
     np.add.at(c, idx, val)
     return c
+
+
+# --- the face stretch DOF (build_model(face_stretch=True)) -----------------------------------
+# With the stretch DOF d (w of the outer surface minus w of the inner one, linear along x), a
+# face's w is w_inner + d L_outer(z): a load on the face's outer surface also works on d, and the
+# face's mid-surface w (where the 2D model reads its probes) is w_inner + d/2.
+
+
+def stretch_row(mesh: BeamMesh, x: float) -> tuple[np.ndarray, np.ndarray]:
+    """Node indices and linear weights of the stretch DOF's value at ``x``."""
+    e, η = mesh.element_at(x)
+    return np.array([e, e + 1]), np.array([0.5 * (1 - η), 0.5 * (1 + η)])
+
+
+def stretch_point_load(mesh: BeamMesh, x: float, force: float) -> np.ndarray:
+    """Work-conjugate nodal loads (per node) on d of a force on the outer surface at ``x``."""
+    f = np.zeros(mesh.n_nodes)
+    idx, val = stretch_row(mesh, x)
+    np.add.at(f, idx, force * val)
+    return f
+
+
+def stretch_patch_load(mesh: BeamMesh, start: float, end: float, force: float) -> np.ndarray:
+    """The same for a uniform load of total ``force`` over [start, end] (per node)."""
+    if not end > start:
+        raise ValueError(f"a patch load needs end > start, got [{start}, {end}]")
+    q = force / (end - start)
+    f = np.zeros(mesh.n_nodes)
+    s, ws = gauss_legendre(2)  # q times a linear function: exact
+    for e in range(mesh.n_elements):
+        a, b = max(start, mesh.x[e]), min(end, mesh.x[e + 1])
+        if b <= a:
+            continue
+        for xq, wq in zip(0.5 * (a + b) + 0.5 * (b - a) * s, ws, strict=True):
+            idx, val = stretch_row(mesh, float(np.clip(xq, mesh.x[e], mesh.x[e + 1])))
+            np.add.at(f, idx, q * 0.5 * (b - a) * wq * val)
+    return f

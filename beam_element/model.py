@@ -25,7 +25,7 @@ from beam_element.contact import (
     penalty_response,
 )
 from beam_element.core_basis import CoreBasis, mode_dofs
-from beam_element.dofs import ELEMENT_DOFS, LAYERS, NODE_DOFS
+from beam_element.dofs import ELEMENT_DOFS, NODE_DOFS
 from beam_element.element import (
     GeometricProducts,
     LayerState,
@@ -37,9 +37,17 @@ from beam_element.fracture import beam_tips, release_columns
 from beam_element.layer_operators import (
     LayerOperators,
     build_core_operators,
+    build_face_operators,
     build_layer_operators,
 )
-from beam_element.loads import patch_load, point_load, probe_row
+from beam_element.loads import (
+    patch_load,
+    point_load,
+    probe_row,
+    stretch_patch_load,
+    stretch_point_load,
+    stretch_row,
+)
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.scene import FACE_MEMBRANES, GRADINGS, BeamModelOptions
@@ -88,9 +96,15 @@ def core_groups(
     element_dofs: np.ndarray,
     n_nodes: int,
     make_op: object,
+    stride: int | None = None,
+    offset: int = 0,
 ) -> list[CoreGroup]:
-    """Group core elements by level; extended DOFs = paper 40, then each node's enrichment."""
-    m = 4 * basis.count(basis.max_level)  # enrichment DOFs per node in the full vector
+    """Group core elements by level; extended DOFs = paper 40, then each node's enrichment.
+
+    ``stride``: extra DOFs per node in the full vector (default: the core enrichment's);
+    ``offset``: where the core enrichment starts in a node's block (after the face stretch).
+    """
+    m = 4 * basis.count(basis.max_level) if stride is None else stride
     groups = []
     for level in np.unique(element_levels):
         els = np.flatnonzero(element_levels == level)
@@ -98,7 +112,8 @@ def core_groups(
         k = len(mode_dofs(basis, int(level)))
         ext = [element_dofs[els]]
         for node in (0, 1):
-            ext.append(NODE_DOFS * n_nodes + m * (els + node)[:, None] + np.arange(k)[None, :])
+            ext.append(NODE_DOFS * n_nodes + m * (els + node)[:, None] + offset
+                       + np.arange(k)[None, :])
         ext_dofs = np.concatenate(ext, axis=1)
         groups.append(CoreGroup(level=int(level), elements=els, op=op,
                                 products=geometric_products(op), dofs=ext_dofs[:, op.dofs]))
@@ -125,6 +140,8 @@ class BeamModel:
     element_levels: np.ndarray | None = None  # core level of every element
     # debond tips (beam_element.fracture.BeamTip) whose G every accepted path state carries
     fracture_tips: list = field(default_factory=list)
+    # full DOFs of each face's element family when the faces carry their stretch DOF
+    face_dofs: dict | None = None
     pattern: ReducedPattern = field(init=False)
     committed: dict[str, ContactSummary] = field(default_factory=dict)
     max_penetration_seen: float = 0.0
@@ -143,12 +160,23 @@ class BeamModel:
         if self.element_levels is None:
             self.element_levels = np.ones(self.mesh.n_elements, dtype=int)
         # Block families: top face, core groups by level, bottom face, contact groups.
-        self.block_dofs = [self.element_dofs[:, self.layers["top"].dofs]]
+        faces = self.face_dofs or {n: self.element_dofs[:, self.layers[n].dofs]
+                                   for n in ("top", "bottom")}
+        self.block_dofs = [faces["top"]]
         self.block_dofs += [g.dofs for g in self.core]
-        self.block_dofs += [self.element_dofs[:, self.layers["bottom"].dofs]]
+        self.block_dofs += [faces["bottom"]]
         self.block_dofs += [p.block_dofs for p in self.pairs]
         self.pattern = reduced_pattern(self.block_dofs, self.dof_map)
         self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
+
+    @property
+    def face_extra(self) -> int:
+        """Face stretch DOFs per node at the head of each node's extra block (0 or 2)."""
+        return 0 if self.face_dofs is None else 2
+
+    def face_family_dofs(self, face: str) -> np.ndarray:
+        """Full DOF indices of ``face``'s element family, shape ``(E, n)`` in its rows' order."""
+        return self.block_dofs[0 if face == "top" else len(self.core) + 1]
 
     # --- DiscreteSystem -------------------------------------------------------------------
     @property
@@ -496,11 +524,12 @@ def build_model(
     grading: str = "graded",
     growth: float = DEFAULT_GROWTH,
     size_ratio: float = DEFAULT_SIZE_RATIO,
-    face_membrane: str = "paper",
-    contact_search: str = "same-x",
+    face_membrane: str | None = None,
+    contact_search: str | None = None,
     contact_reach: float = DEFAULT_REACH,
     core_level: int | np.ndarray | None = None,
     core_basis: str = "sublayers",
+    face_stretch: bool | None = None,
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -527,17 +556,18 @@ def build_model(
         ``"tips"`` grades towards the centres only (the default until 2026-11-22);
         ``"uniform"`` keeps one size.
     face_membrane
-        ``"paper"`` (default): the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"``
-        (option, departs from the paper): the faces' ε_x is its element mean along x (assumed
-        membrane strain; removes membrane locking, see docs/beam_vs_2d.md).
+        ``"paper"``: the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"`` (departs
+        from the paper): the faces' ε_x is its element mean along x (assumed membrane strain;
+        removes membrane locking, see docs/beam_vs_2d.md). Default: the scene's
+        ``[beam_model] face_membrane`` (``"averaged"``).
     contact_search
         Pairing on debonded stretches (:func:`~beam_element.contact.contact_pairs`):
-        ``"same-x"`` (default): each untied face node against the core point of the same x
-        (the paper's closest-node rule under small sliding); ``"closest-point"``: the node
-        projected on the deformed core boundary curve (node-to-segment, consistent
-        linearisation, continuous beyond the search reach, docs/contact_search.md). Not the
-        default: it costs 1.5-4x the wall time (fig. 5 at 480 elements would miss the 10 s
-        target) for a +0.5 % change of λ(−15) on fig. 5 and < 0.1 % on c3.
+        ``"same-x"`` (the paper's closest-node rule under small sliding): each untied face
+        node against the core point of the same x; ``"closest-point"``: the node projected on
+        the deformed core boundary curve (node-to-segment, consistent linearisation, continuous
+        beyond the search reach, docs/contact_search.md). Default: the scene's
+        ``[beam_model] contact_search`` (``"closest-point"``: with the faces' stretch and core
+        levels ≥ 3 the same-x pairing stalls on fig. 5, docs/beam_vs_2d.md).
     contact_reach
         Closest-point search: the segments within this distance (mm) on each side of a node, at
         least one per side, are searched (default ``DEFAULT_REACH``).
@@ -547,10 +577,22 @@ def build_model(
         :mod:`beam_element.core_levels`); default 1, the paper's core.
     core_basis
         Enrichment family of levels > 1: ``"sublayers"`` (default) or ``"polynomial"``.
+    face_stretch
+        ``False`` (the paper's faces): a face's w is constant through its thickness.
+        ``True``: each face gets a stretch DOF per node
+        (:func:`~beam_element.layer_operators.build_face_operators`), so that a rotated face
+        bends as stiffly as an unrotated one; stored first in each node's extra block.
+        Default: the scene's ``[beam_model] faces`` (``"stretch"`` unless it says ``"paper"``).
     """
+    options = getattr(scene, "beam_model", None)
+    if face_membrane is None:
+        face_membrane = getattr(options, "face_membrane", BeamModelOptions.face_membrane)
+    if contact_search is None:
+        contact_search = getattr(options, "contact_search", BeamModelOptions.contact_search)
     if face_membrane not in FACE_MEMBRANES:
         raise ValueError(f"face_membrane must be one of {FACE_MEMBRANES}, got {face_membrane!r}")
-    options = getattr(scene, "beam_model", None)
+    if face_stretch is None:
+        face_stretch = getattr(options, "faces", BeamModelOptions.faces) == "stretch"
     if elements is None:
         elements = getattr(options, "elements", BeamModelOptions.elements)
     mesh = beam_mesh(scene, elements, grading=grading, growth=growth, size_ratio=size_ratio)
@@ -564,9 +606,17 @@ def build_model(
                  "core": core_stiffness(scene.core.material),
                  "bottom": face_stiffness(scene.bottom.material)}
     thickness = {"top": ht, "core": hc, "bottom": hb}
-    layers = {n: build_layer_operators(
-        n, thickness[n], z_bottom[n], stiffness[n], gauss=orders[n],
-        membrane_average=(n != "core" and face_membrane == "averaged")) for n in LAYERS}
+    if face_stretch:  # the face's through-thickness modulus, uncoupled (σ_z = E ε_z)
+        for n in ("top", "bottom"):
+            stiffness[n] = stiffness[n].copy()
+            stiffness[n][1, 1] = stiffness[n][0, 0]
+    layers = {"core": build_layer_operators("core", hc, z_bottom["core"], stiffness["core"],
+                                            gauss=orders["core"])}
+    for n in ("top", "bottom"):
+        layers[n] = build_face_operators(n, thickness[n], z_bottom[n], stiffness[n],
+                                         gauss=orders[n],
+                                         membrane_average=face_membrane == "averaged",
+                                         stretch=face_stretch)
     products = {n: geometric_products(op) for n, op in layers.items()}
     levels = np.broadcast_to(np.asarray(1 if core_level is None else core_level, dtype=int),
                              (mesh.n_elements,)).copy()
@@ -575,20 +625,34 @@ def build_model(
     basis = CoreBasis(core_basis, int(levels.max()))
     groups: list[CoreGroup] = []
     m = 4 * basis.count(basis.max_level)
+    fs = 2 if face_stretch else 0  # face stretch DOFs per node (top, bottom), first in the block
+    e = np.arange(mesh.n_elements)[:, None]
     if basis.max_level > 1:
-        e = np.arange(mesh.n_elements)[:, None]
         groups = core_groups(
             basis, levels, NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :], mesh.n_nodes,
             lambda level: build_core_operators(hc, z_bottom["core"], stiffness["core"], basis,
-                                               level, gauss=orders["core"]))
+                                               level, gauss=orders["core"]),
+            stride=m + fs, offset=fs)
     mode_active = (np.arange(m)[None, :]
                    < 4 * np.array([basis.count(int(k)) for k in node_levels(levels)])[:, None])
+    face_dofs = None
+    if face_stretch:
+        mode_active = np.concatenate([np.ones((mesh.n_nodes, 2), dtype=bool), mode_active], 1)
+        paper = NODE_DOFS * e + np.arange(ELEMENT_DOFS)[None, :]
+        face_dofs = {}
+        for j, n in enumerate(("top", "bottom")):
+            ext = NODE_DOFS * mesh.n_nodes + (m + fs) * (e + np.arange(2)[None, :]) + j
+            face_dofs[n] = np.concatenate([paper, ext], axis=1)[:, layers[n].dofs]
 
     tol = 1e-9 * scene.length
     bonded = {i: np.array([scene.is_bonded(i, float(x), tol) for x in mesh.x])
               for i in ("top", "bottom")}
     supports = [NodeSupport(mesh.node_at(s.x, 1e-6 * scene.length), face, s.type)
                 for s in scene.supports for face in s.faces]
+    if face_stretch:  # a clamp holds the face's whole end section: no thickness change there
+        for s in supports:
+            if s.type == "clamp":
+                mode_active[s.node, ("top", "bottom").index(s.face)] = False
     dof_map = build_dof_map(mesh.n_nodes, bonded, supports, mode_active)
 
     f_ref = np.zeros(NODE_DOFS * mesh.n_nodes)
@@ -597,9 +661,20 @@ def build_model(
             f_ref += point_load(mesh, load.on, load.x, load.force)
         else:
             f_ref += patch_load(mesh, load.on, *load.span, load.force)
-    f_ref = np.concatenate([f_ref, np.zeros(mode_active.size)])  # no load on the enrichment
-    probes = {p.name: np.concatenate([probe_row(mesh, p.on, p.x), np.zeros(mode_active.size)])
-              for p in scene.probes}
+    extra = np.zeros(mode_active.shape)  # no load on the core enrichment
+    if face_stretch:  # loads act on the faces' outer surfaces: they work on d too
+        for load in scene.loads:
+            j = ("top", "bottom").index(load.on)
+            extra[:, j] += (stretch_point_load(mesh, load.x, load.force) if load.width == 0
+                            else stretch_patch_load(mesh, *load.span, load.force))
+    f_ref = np.concatenate([f_ref, extra.ravel()])
+    probes = {}
+    for p in scene.probes:  # w of the face's mid-surface (where the 2D model reads it)
+        extra = np.zeros(mode_active.shape)
+        if face_stretch:
+            nodes, weights = stretch_row(mesh, p.x)
+            extra[nodes, ("top", "bottom").index(p.on)] = 0.5 * weights
+        probes[p.name] = np.concatenate([probe_row(mesh, p.on, p.x), extra.ravel()])
 
     pairs = [group for i in ("top", "bottom") if np.any(~bonded[i])
              for group in contact_pair_groups(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width,
@@ -615,6 +690,7 @@ def build_model(
         dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,
         probe_rows=probes, face_thickness={"top": ht, "bottom": hb},
         smoothing=float(contact_smoothing), core=groups, element_levels=levels,
+        face_dofs=face_dofs,
     )
     model.fracture_tips = beam_tips(scene, model)
     return model

@@ -211,8 +211,11 @@ def run(
         raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
     bm = scene.beam_model
     options = {"grading": getattr(bm, "grading", "graded"),
-               "face_membrane": getattr(bm, "face_membrane", "paper"),
-               "core_basis": getattr(bm, "core_basis", "sublayers"), **(model_options or {})}
+               "face_membrane": getattr(bm, "face_membrane", "averaged"),
+               "contact_search": getattr(bm, "contact_search", "closest-point"),
+               "core_basis": getattr(bm, "core_basis", "sublayers"),
+               "face_stretch": getattr(bm, "faces", "stretch") == "stretch",
+               **(model_options or {})}
     choice = choose_core_levels(scene, elements, options)
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []
@@ -320,6 +323,9 @@ def run(
     solution.extra.update(_growth_summary(scene, solution))
     if level_warning(model, beam_tips(scene, model)):
         solution.extra["G_warning"] = level_warning(model, beam_tips(scene, model))
+    solution.extra["faces"] = "stretch" if options["face_stretch"] else "paper"
+    solution.extra["face_membrane"] = options["face_membrane"]
+    solution.extra["contact_search"] = options["contact_search"]
     solution.extra["core"] = {
         "how": choice.how, "basis": options["core_basis"],
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,

@@ -17,7 +17,13 @@ Cases (scene, target, 2D reference):
   ``fine`` run, solved here.
 
 Variants: ``L<k>`` every element at level k (``P<k>``: the polynomial family), ``auto`` the
-scene default (error indicator against ``[beam_model] tolerance``). Elements: the scene's
+scene default (error indicator against ``[beam_model] tolerance``). Without a suffix a variant
+runs the scene defaults (stretch faces, averaged face membrane, closest-point contact); suffix
+letters switch one of them back to the paper's choice: ``f`` the paper's faces (``faces =
+"paper"``: w constant through a face), ``m`` the paper's membrane strain (``face_membrane =
+"paper"``), ``s`` same-x contact pairing (``contact_search = "same-x"``), ``p`` all three — so
+``L1p`` is the paper's element. Rows written before 2026-12-02 (no ``faces`` column) were run
+with all three of the paper's choices and are named with ``p``. Elements: the scene's
 (240) unless ``--elements``. The machine's load average is recorded with every row.
 """
 
@@ -49,7 +55,24 @@ CASES = {
 }
 REFERENCE_LEVEL = {"bend": "fine", "c3": "medium", "demo": "fine"}
 FIELDS = ["case", "variant", "elements", "dofs", "levels", "estimate", "lambda_end", "reached",
-          "steps", "iterations", "seconds", "load", "w_end", "max_steps"]
+          "steps", "iterations", "seconds", "load", "w_end", "max_steps", "faces", "membrane",
+          "contact"]
+PAPER_CHOICES = {"f": ("faces", "paper"), "m": ("membrane", "paper"), "s": ("contact", "same-x")}
+
+
+def parse_variant(variant: str) -> tuple[str, dict[str, str]]:
+    """(core part ``L3``/``P2``/``auto``, {faces, membrane, contact}) of a variant name."""
+    core = variant
+    choice = {"faces": "stretch", "membrane": "averaged", "contact": "closest-point"}
+    while core and core[-1] in "pfms" and core != "auto":
+        for letter in ("fms" if core[-1] == "p" else core[-1]):
+            key, value = PAPER_CHOICES[letter]
+            choice[key] = value
+        core = core[:-1]
+    if core != "auto" and not (core[:1] in ("L", "P") and core[1:].isdigit()):
+        raise SystemExit(f"unknown variant {variant!r}: expected L<k>, P<k> or auto, optionally "
+                         "followed by f, m, s or p (the paper's faces, membrane, contact, all)")
+    return core, choice
 
 
 def case_scene(case: str, max_steps: int | None = None):
@@ -96,10 +119,12 @@ def solve_reference(case: str) -> None:
 
 def one(case: str, variant: str, elements: int | None, max_steps: int | None = None) -> dict:
     scene = case_scene(case, max_steps)
-    opts: dict = {}
-    if variant != "auto":
-        opts = {"core_level": int(variant[1:]),
-                "core_basis": "polynomial" if variant[0] == "P" else "sublayers"}
+    core_part, choice = parse_variant(variant)
+    opts: dict = {"face_stretch": choice["faces"] == "stretch",
+                  "face_membrane": choice["membrane"], "contact_search": choice["contact"]}
+    if core_part != "auto":
+        opts.update(core_level=int(core_part[1:]),
+                    core_basis="polynomial" if core_part[0] == "P" else "sublayers")
     load = os.getloadavg()[0]
     t = time.perf_counter()
     r = run(scene, elements=elements, model_options=opts)
@@ -117,7 +142,7 @@ def one(case: str, variant: str, elements: int | None, max_steps: int | None = N
                 steps=len(s.history), iterations=s.extra["total_newton_iterations"],
                 seconds=f"{seconds:.2f}", load=f"{load:.2f}",
                 w_end=f"{s.history[-1].probes[scene.analysis.until_probe]:.4g}",
-                max_steps=scene.analysis.max_steps)
+                max_steps=scene.analysis.max_steps, **choice)
 
 
 def report() -> None:
@@ -141,8 +166,9 @@ def report() -> None:
             continue
         _, until, kind = CASES[case]
         lines += [f"## {case} ({kind}, to {until:g} mm): 2D λ = {ref:.6g} ({src})", "",
-                  "| variant | elements | DOFs | levels | estimate | λ | err | reached | steps | "
-                  "s | load |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "| variant | faces | membrane | contact | elements | DOFs | levels | estimate "
+                  "| λ | err | reached | steps | s | load |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
             if r["case"] != case:
                 continue
@@ -151,14 +177,17 @@ def report() -> None:
             said = (f"{100 * err:+.2f} %" if reached else
                     f"— (stopped at w = {r.get('w_end') or '?'} mm, max_steps "
                     f"{r.get('max_steps') or '?'})")
-            lines.append(f"| {r['variant']} | {r['elements']} | {r['dofs']} | {r['levels']} | "
+            lines.append(f"| {r['variant']} | {r.get('faces') or 'paper'} | "
+                         f"{r.get('membrane') or 'paper'} | {r.get('contact') or 'same-x'} | "
+                         f"{r['elements']} | {r['dofs']} | "
+                         f"{r['levels']} | "
                          f"{r['estimate']} | {r['lambda_end']} | {said} | "
                          f"{r['reached']} | {r['steps']} | {r['seconds']} | {r['load']} |")
             if not reached:
                 continue
-            ax.loglog(float(r["seconds"]), abs(err) + 1e-5,
-                      "o" if r["variant"] != "auto" else "*", ms=10 if r["variant"] == "auto"
-                      else 6)
+            auto = r["variant"].startswith("auto")
+            ax.loglog(float(r["seconds"]), abs(err) + 1e-5, "*" if auto else "o",
+                      ms=10 if auto else 6)
             ax.annotate(r["variant"], (float(r["seconds"]), abs(err) + 1e-5), fontsize=7)
         lines.append("")
         ax.set(title=case, xlabel="beam wall time (s)", ylabel="|λ/λ_2D − 1|")

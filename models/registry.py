@@ -82,7 +82,7 @@ class ModelSpec:
 MODELS: dict[str, ModelSpec] = {
     "beam": ModelSpec("beam", _solve_beam, "beam_model",
                       ("elements", "grading", "core", "core_basis", "max_core_level",
-                       "core_zones", "tolerance", "face_membrane"),
+                       "core_zones", "tolerance", "face_membrane", "faces", "contact_search"),
                       ("beam_element", "sandwich")),
     "2d": ModelSpec("2d", _solve_2d, "reference2d",
                     ("level", "refine", "face_elements", "core_size", "face_size", "tip_size",

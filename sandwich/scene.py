@@ -20,6 +20,8 @@ ANALYSIS_KINDS = ("linear", "nonlinear")
 CONTROLS = ("load", "displacement", "arc-length")
 GRADINGS = ("graded", "tips", "uniform")  # [beam_model] grading: the beam mesh along x
 FACE_MEMBRANES = ("paper", "averaged")  # [beam_model] face_membrane
+FACE_KINEMATICS = ("stretch", "paper")  # [beam_model] faces
+CONTACT_SEARCHES = ("closest-point", "same-x")  # [beam_model] contact_search
 MESH_LEVELS = ("coarse", "medium", "fine", "explicit")  # [reference2d] level: the 2D mesh
 # Scene and probe names become folder and file names (results/<scene>/, load_<probe>.png)
 NAME_PATTERN = r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}"
@@ -179,7 +181,11 @@ class BeamModelOptions:
     elements: int = 240  # fig5 to -15 mm: 240 graded elements within 4.5 % (paper element)
     grading: str = "graded"  # "graded" (small at supports, load edges, debond tips and all along
     # debonds) | "tips" (small at the points only) | "uniform"
-    face_membrane: str = "paper"  # "paper" | "averaged" (element-mean face strain: no locking)
+    face_membrane: str = "averaged"  # "averaged" (element-mean face strain: no membrane
+    # locking) | "paper" (eq. 15 at every point)
+    faces: str = "stretch"  # "stretch" (w linear through each face: rotated faces bend right) |
+    # "paper" (w constant through each face, the paper's eq. 13)
+    contact_search: str = "closest-point"  # "closest-point" (node to segment) | "same-x"
     gauss_x: int | None = None  # None: the rule that integrates the strain energy exactly
     gauss_z: int | None = None
     contact_penalty: float | None = None

@@ -13,8 +13,10 @@ from typing import Any
 
 from sandwich.scene import (
     ANALYSIS_KINDS,
+    CONTACT_SEARCHES,
     CONTROLS,
     CORE_BASES,
+    FACE_KINEMATICS,
     FACE_MEMBRANES,
     FACES,
     GRADINGS,
@@ -475,7 +477,8 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     key = "beam_model"
-    t = r.table(tbl, key, ("elements", "grading", "face_membrane", "gauss_x", "gauss_z",
+    t = r.table(tbl, key, ("elements", "grading", "face_membrane", "faces", "contact_search",
+                           "gauss_x", "gauss_z",
                            "contact_penalty", "profile_every", "core", "core_basis", "tolerance",
                            "max_core_level", "core_zones"))
     if t is None:
@@ -519,6 +522,9 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
         or d.grading,
         face_membrane=r.choice(t, "face_membrane", key, FACE_MEMBRANES,
                                default=d.face_membrane) or d.face_membrane,
+        faces=r.choice(t, "faces", key, FACE_KINEMATICS, default=d.faces) or d.faces,
+        contact_search=r.choice(t, "contact_search", key, CONTACT_SEARCHES,
+                                default=d.contact_search) or d.contact_search,
         gauss_x=r.integer(t, "gauss_x", key, default=None, lo=2, hi=12),
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),

@@ -404,7 +404,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("solve", parents=[common], help="solve a scene with one model")
     s.add_argument("scene", help="scene file (TOML)")
     s.add_argument("--model", choices=tuple(MODELS), required=True,
-                   help="beam: the paper's element; 2d: the plane-stress reference (FEniCSx)")
+                   help="beam: the sandwich beam element (the paper's, refined through the "
+                   "thickness); 2d: the plane-stress reference (FEniCSx)")
     s.add_argument("--out", help="result folder (default results/<scene>/<model>/)")
     s.add_argument("--level", choices=MESH_LEVELS, help="2D mesh level (overrides the scene)")
     s.add_argument("--refine", type=int, metavar="N",

@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from beam_element import run
-from beam_element.dofs import DOF_NAMES
+from beam_element.dofs import DOF_NAMES, NODE_DOFS
 from beam_element.fields import sample_layer
 from sandwich.scene import Analysis, BeamModelOptions, Layer, Load, Material, Probe, Scene, Support
 from sandwich.scene_file import load_scene
@@ -79,7 +79,7 @@ FIELDS = ["section", "case", "grading", "state", "elements", "interface", "h_max
 def interface_mismatch(scene: Scene, model: object, u: np.ndarray, nonlinear: bool) -> dict:
     """δu on the bonded elements of each interface; see the module docstring."""
     u_full = model.expand(u)
-    nodal = u_full.reshape(model.mesh.n_nodes, -1)
+    nodal = u_full[:NODE_DOFS * model.mesh.n_nodes].reshape(model.mesh.n_nodes, NODE_DOFS)
     x = model.mesh.x
     tol = 1e-9 * scene.length
     out = {}

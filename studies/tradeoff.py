@@ -13,10 +13,12 @@ every resolution; wall times are measured here. The error of every run is taken 
 Writes ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` (error vs time, Pareto fronts)
 into ``benchmarks/results/comparisons/``.
 
-Beam variants: ``paper`` (the paper's element: core level 1), ``averaged`` (core level 1 with
-``face_membrane = "averaged"``, not the paper's, see docs/beam_vs_2d.md), ``L2``…``L6`` (every
-element at that core level, docs/beam_element.md "Core levels") and ``auto`` (``core = "auto"``,
-the scene default: levels from the error indicator, the path rerun to check them).
+Beam variants: ``paper`` (the paper's element: core level 1, ``faces = "paper"``,
+``face_membrane = "paper"``, ``contact_search = "same-x"``), ``averaged`` (the same with
+``face_membrane = "averaged"``, see docs/beam_vs_2d.md), ``L1``…``L6`` (every element at that
+core level, docs/beam_element.md "Core levels", with the scene defaults: stretch faces, averaged
+membrane, closest-point contact) and ``auto`` (``core = "auto"``, the scene default: levels from
+the error indicator, the path rerun to check them).
 ``--until NAME=VALUE`` ends a scene's path earlier (the fig4 2D core crushes at w ≈ −13 mm, so
 its path is compared to −12 mm). Wall and CPU seconds are both recorded: on a shared machine
 the CPU time is the steadier of the two.
@@ -45,7 +47,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from models import MODELS, with_options  # noqa: E402
 from sandwich.results import Solution  # noqa: E402
-from sandwich.scene import Scene  # noqa: E402
+from sandwich.scene import BeamModelOptions, Scene  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]  # the project: scenes/, benchmarks/results/
@@ -71,17 +73,21 @@ class Run:
     cpu_seconds: float = math.nan
 
 
-VARIANTS = ("paper", "averaged", "L2", "L3", "L4", "L5", "L6", "auto")
+VARIANTS = ("paper", "averaged", "L1", "L2", "L3", "L4", "L5", "L6", "auto")
 
 
 def with_beam_elements(scene: Scene, n: int, variant: str = "paper") -> Scene:
     """``scene`` with ``n`` beam elements and the beam ``variant`` (see :data:`VARIANTS`)."""
-    if variant in ("paper", "averaged"):
-        core, membrane = 1, variant
-    else:
-        core, membrane = ("auto" if variant == "auto" else int(variant[1:])), "paper"
+    if variant in ("paper", "averaged"):  # the paper's element (and its averaged membrane)
+        options = {"core": 1, "face_membrane": variant, "faces": "paper",
+                   "contact_search": "same-x"}
+    else:  # core levels with the scene defaults of faces, membrane and contact
+        d = BeamModelOptions()
+        options = {"core": "auto" if variant == "auto" else int(variant[1:]),
+                   "face_membrane": d.face_membrane, "faces": d.faces,
+                   "contact_search": d.contact_search}
     return dataclasses.replace(scene, beam_model=dataclasses.replace(
-        scene.beam_model, elements=n, face_membrane=membrane, core=core, core_zones=()))
+        scene.beam_model, elements=n, core_zones=(), **options))
 
 
 def with_until(scene: Scene, value: float) -> Scene:

@@ -237,8 +237,8 @@ def test_consistent_tangent_with_sliding_and_rotation(interface):
 
 def test_contact_search_option_and_its_validation():
     scene = load_scene(FIG5)
-    same = build_model(scene, elements=40)  # the default (docs/contact_search.md, decision)
-    closest = build_model(scene, elements=40, contact_search="closest-point")
+    closest = build_model(scene, elements=40)  # the default since 2026-12-02 (scene key)
+    same = build_model(scene, elements=40, contact_search="same-x")
     assert [p.search for p in same.pairs] == ["same-x"]
     assert [p.search for p in closest.pairs] == ["closest-point"]
     assert np.array_equal(same.pairs[0].nodes, closest.pairs[0].nodes)

@@ -85,9 +85,14 @@ def test_debond_in_pure_compression_behaves_like_bonded_normally():
 
 
 def _fig5_like(elements, until):
+    # Displacement control: past w ≈ −3.7 mm the debonded face buckles and, at 60 elements with
+    # the averaged face membrane (the default since 2026-12-02), the load stays within 0.05 %
+    # over 0.2 mm of deflection (measured with arc-length: 706.8 → 707.1 N from −3.72 to
+    # −3.90 mm), which load control cannot cross; the symmetry checked here is a property of the
+    # states, not of the control.
     return sandwich_scene(
         elements=elements, debonds=(Debond("top", 130.0, 170.0),),
-        analysis=Analysis(kind="nonlinear", control="load", until_probe="w_top_mid",
+        analysis=Analysis(kind="nonlinear", control="displacement", until_probe="w_top_mid",
                           until_value=until, max_steps=100))
 
 

@@ -37,11 +37,15 @@ def test_field_frames_of_last_and_every_kth_step():
     area = 0.5 * np.sum(q[:, :, 0] * np.roll(q[:, :, 1], -1, axis=1)
                         - np.roll(q[:, :, 0], -1, axis=1) * q[:, :, 1], axis=1)
     assert np.all(area > 0)
-    # the top face's mid-span point moves by the recorded probe value
+    # the top face's mid-span section moves by the recorded probe value at its mid-surface:
+    # w is linear through the face, so the mean of its inner and outer surface points
     at = np.flatnonzero(np.isclose(frame.points[:, 0], 150.0)
-                        & (frame.points[:, 1] > scene.core.thickness / 2))
-    assert at.size > 0
-    assert np.allclose(frame.displacement[at, 1], last.probes["w_top_mid"], rtol=1e-9)
+                        & (frame.points[:, 1] >= scene.core.thickness / 2 - 1e-12))
+    z = frame.points[at, 1]
+    inner, outer = at[np.argmin(z)], at[np.argmax(z)]
+    assert z.max() - z.min() > 0.9 * scene.top.thickness
+    mid = 0.5 * (frame.displacement[inner, 1] + frame.displacement[outer, 1])
+    assert np.isclose(mid, last.probes["w_top_mid"], rtol=1e-9)
     # summary.json: every extra is plain JSON without NaN (the core block is a nested table)
     json.dumps(sol.extra, allow_nan=False)
     assert all(isinstance(v, int | float | str | bool) for k, v in sol.extra.items() if k != "core")

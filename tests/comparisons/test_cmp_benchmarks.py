@@ -108,9 +108,13 @@ def test_extremes_agreement_over_the_common_range_when_a_model_stops_early(scene
 
 
 def test_tradeoff_variants_set_the_core_level(scene):
-    """``paper``/``averaged`` are the paper's core (level 1), ``L<k>`` level k, ``auto`` auto."""
-    cases = {"paper": (1, "paper"), "averaged": (1, "averaged"), "L3": (3, "paper"),
-             "auto": ("auto", "paper")}
-    for variant, (core, membrane) in cases.items():
+    """``paper``/``averaged`` are the paper's element (level 1, the paper's faces and same-x
+    contact; membrane as named), ``L<k>`` level k and ``auto`` auto with the scene defaults."""
+    paper = ("paper", "same-x")
+    default = ("stretch", "closest-point")
+    cases = {"paper": (1, "paper", paper), "averaged": (1, "averaged", paper),
+             "L3": (3, "averaged", default), "auto": ("auto", "averaged", default)}
+    for variant, (core, membrane, (faces, search)) in cases.items():
         bm = tradeoff.with_beam_elements(scene, 30, variant).beam_model
-        assert (bm.core, bm.face_membrane, bm.elements) == (core, membrane, 30), variant
+        assert (bm.core, bm.face_membrane, bm.elements, bm.faces, bm.contact_search) == (
+            core, membrane, 30, faces, search), variant

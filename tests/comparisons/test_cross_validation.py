@@ -62,11 +62,11 @@ def _solvers():
     return {m: MODELS[m].solve for m in ("beam", "2d")}
 
 
-def _compare(tmp_path, name, until):
+def _compare(tmp_path, name, until, level=REF_LEVEL):
     scene = load_scene(ROOT / "scenes" / f"{name}.toml")
     scene = dataclasses.replace(
         scene, analysis=dataclasses.replace(scene.analysis, until_value=until),
-        reference2d=dataclasses.replace(scene.reference2d, level=REF_LEVEL, refine=0))
+        reference2d=dataclasses.replace(scene.reference2d, level=level, refine=0))
     cmp = compare(scene, tmp_path / "out", results_root=tmp_path / "res", reuse=False,
                   solvers=_solvers())
     assert not cmp.missing, cmp.missing
@@ -95,9 +95,19 @@ def test_beam_agrees_with_2d(tmp_path, name, until):
 
 def test_fig5_beyond_face_buckling(tmp_path):
     """Past the debonded face's buckling (w = −5 mm): the paper's element alone was ~7 % too
-    stiff here (a strict xfail until the core hierarchy); with auto core levels it is within
-    the original 3 %/5 % (measured 2026-12-01: L2 1.0 %, max 1.5 % against 2D coarse)."""
+    stiff here (a strict xfail until the core hierarchy), auto core levels with the paper's faces
+    1.0 % (L2) / 1.5 % (max) against 2D coarse; with the stretch faces, averaged membrane and
+    closest-point contact (the defaults since 2026-12-02) 0.21 % / 0.39 %, so it is held to the
+    same 1 % / 1.5 % as the paths before buckling (was 3 % / 5 %)."""
     cmp = _compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0)
-    load = cmp.metrics.curve("load_factor")
-    assert load is not None and load.l2_relative is not None, cmp.metrics.notes
-    assert load.l2_relative <= 0.03 and load.max_relative <= 0.05, load
+    _load_curve_agrees(cmp)
+
+
+def test_fig5_to_the_end_of_its_path(tmp_path):
+    """The whole shipped fig5 path (to w = −15 mm, the debonded face buckled and pressed)
+    against the 2D model at level medium (0.17 % from 2D fine at the end; coarse is 1.7 %, more
+    than the beam's error here). With the paper's faces auto was 8.8 % too stiff at the end; with
+    the defaults since 2026-12-02 the load curves agree within 0.30 % (L2), 0.49 % (max), measured
+    (~1 min). Held to the 1 % / 1.5 % of the other paths."""
+    cmp = _compare(tmp_path, "paper-fig5-top-debond-40-load-top", -15.0, level="medium")
+    _load_curve_agrees(cmp)

@@ -19,6 +19,7 @@ from fracture_cases import (
 )
 
 from beam_element.constraints import NodeSupport, build_dof_map
+from beam_element.dofs import NODE_DOFS
 from beam_element.fracture import beam_tips, column_names, tip_releases
 from beam_element.solve import linear_solution, run
 
@@ -87,7 +88,9 @@ def _untie(model, scene_, node):
     bonded["top"][node] = False
     supports = [NodeSupport(model.mesh.node_at(s.x, 1e-6 * scene_.length), f, s.type)
                 for s in scene_.supports for f in s.faces]
-    return dataclasses.replace(model, dof_map=build_dof_map(model.mesh.n_nodes, bonded, supports),
+    n = model.mesh.n_nodes  # the enrichment (core levels, face stretch) stays as it was
+    active = (model.dof_map.free[NODE_DOFS * n:] >= 0).reshape(n, -1)
+    return dataclasses.replace(model, dof_map=build_dof_map(n, bonded, supports, active),
                                _cache=None)
 
 
