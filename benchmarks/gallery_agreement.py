@@ -37,25 +37,28 @@ from sandwich.results import load_result  # noqa: E402
 # benchmarks/results/comparisons/tradeoff.md (2D coarse/medium/fine on fig4/fig5).
 TRUST: dict[str, str] = {
     "paper-fig4-bonded-3pb": (
-        "to ≈ −12 mm only: past it the St. Venant–Kirchhoff core crushes under the 10 mm patch "
-        "(2D load maximum ≈ 1918 at w ≈ −13 mm, not a structural instability); 2D fine stopped "
-        "before −12 mm in tradeoff.csv"),
+        "up to its load maximum only (λ ≈ 1912 at w ≈ −13.4 mm, where its arc step turns "
+        "back): the St. Venant–Kirchhoff core crushes under the 10 mm patch; the beam at "
+        "core = 3 crushes there too (max 1921.6 at −12.9 mm, then w snaps back to −8.4 mm; "
+        "docs/comparisons.md), so neither model past it"),
     "paper-fig5-top-debond-40-load-top": (
         "yes: 2D coarse→fine within 1.7 % at −15 mm (tradeoff.md)"),
     "paper-fig6-top-debond-20-load-bottom": (
-        "partly: core corners at the pins crush (README); the path may bifurcate past the "
-        "face's buckling (buckled/unbuckled branches, README)"),
+        "yes along this path (both models on the same branch: first maximum within 0.7 %); "
+        "the core corners at the pins crush in 2D under larger loads (README); no 2D mesh "
+        "check"),
     "paper-fig7-cantilever-c1": (
-        "no past its maximum: the 2D maximum (713 on 2026-11-22) is core crushing at the clamp "
-        "or under the tip patch (docs/comparisons.md)"),
+        "up to its maximum (713) only: after it an element inverts in the core near the clamp "
+        "(x = 15.4, z = −11.8 mm) and the path creeps back; the beam crushes there too, with "
+        "its core estimate 4.9 % (zones at max_core_level 3)"),
     "paper-fig7-cantilever-c2": (
-        "no past its maximum: the 2D maximum (656 on 2026-11-22) is core crushing at the clamp "
-        "(README, docs/comparisons.md)"),
+        "up to its maximum (656) only: then the path snaps back and wanders to λ < 0, an "
+        "element inverted at the clamp corner (x = 0, z = −12.5 mm); no mesh check"),
     "paper-fig7-cantilever-c3": (
         "yes, not mesh-converged: its G changes 17 % coarse→medium; the beam's L2→L3 move "
         "0.8 % away from it (README)"),
-    "paper-fig7-cantilever-c4": "as c3 (same geometry, mirrored debond): not mesh-checked",
-    "paper-fig9-clamped-d0": "no mesh check; clamped ends: crushing possible at the clamps",
+    "paper-fig7-cantilever-c4": "as c3 (the same clamp, both faces debonded): no mesh check",
+    "paper-fig9-clamped-d0": "no mesh check, no crushing seen on the path to −10 mm",
 }
 for _d in (10, 16, 20, 30, 40):
     TRUST[f"paper-fig9-clamped-d{_d}"] = TRUST["paper-fig9-clamped-d0"]
@@ -88,6 +91,8 @@ def scene_row(folder: Path) -> dict[str, object]:
         row[f"{model}_steps"] = s["steps"]
         row[f"{model}_final_load"] = s["final_load_factor"]
         row[f"{model}_wall_s"] = s["wall_seconds"]
+        lims = s.get("limit_loads") or []
+        row[f"{model}_first_max"] = lims[0]["load_factor"] if lims else None
         row[f"{model}_message"] = s["message"] if (not s["converged"] or "WARNING" in
                                                    (s["message"] or "")) else ""
         try:
@@ -114,6 +119,8 @@ def scene_row(folder: Path) -> dict[str, object]:
         row["beam_load_at_w_end"], row["2d_load_at_w_end"] = lam["beam"], lam["2d"]
         row["end_load_rel"] = (lam["beam"] / lam["2d"] - 1.0
                                if lam["beam"] is not None and lam["2d"] else None)
+    b, r = row.get("beam_first_max"), row.get("2d_first_max")
+    row["first_max_rel"] = b / r - 1.0 if b is not None and r else None
     load = next((c for c in metrics["curves"] if c["quantity"] == LOAD), None)
     row["load_l2"] = load["l2_relative"] if load else None
     row["load_max"] = load["max_relative"] if load else None
@@ -136,17 +143,21 @@ def markdown(rows: list[dict[str, object]], source: str, header: str) -> str:
              "end load: λ_beam/λ_2D − 1 at w_end, the largest |until probe| both monotone paths "
              "reach (interpolated in each history); L2/max: the load-curve errors of "
              "`metrics.json` over the same common range; reach: |until probe| at the end of each "
-             "monotone path; wall: each model's `wall_seconds`.", "",
-             "| scene | w_end (mm) | λ beam | λ 2D | end load | load L2 | load max | beam reach "
-             "/ steps / wall (s) | 2D reach / steps / wall (s) | beam core levels (estimate) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "monotone path; first max: the first load maximum detected on each history "
+             "(`metrics.json` → `limit_loads`); wall: each model's `wall_seconds`.", "",
+             "| scene | w_end (mm) | λ beam | λ 2D | end load | load L2 | load max | first max λ "
+             "beam / 2D | beam reach / steps / wall (s) | 2D reach / steps / wall (s) | beam "
+             "core levels (estimate) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         est = r.get("beam_estimate")
         lines.append(
             f"| {r['scene'].removeprefix('paper-')} | {_g(r.get('w_end'), '.3g')} | "
             f"{_g(r.get('beam_load_at_w_end'))} | {_g(r.get('2d_load_at_w_end'))} | "
             f"{_pct(r.get('end_load_rel'), True)} | {_pct(r.get('load_l2'))} | "
-            f"{_pct(r.get('load_max'))} | {_g(r.get('beam_reach'), '.3g')} / "
+            f"{_pct(r.get('load_max'))} | {_g(r.get('beam_first_max'))} / "
+            f"{_g(r.get('2d_first_max'))} ({_pct(r.get('first_max_rel'), True)}) | "
+            f"{_g(r.get('beam_reach'), '.3g')} / "
             f"{r['beam_steps']} / {_g(r['beam_wall_s'], '.3g')} | "
             f"{_g(r.get('2d_reach'), '.3g')} / {r['2d_steps']} / {_g(r['2d_wall_s'], '.3g')} | "
             f"{r.get('beam_levels', '')} ({_pct(est)}) |")
