@@ -21,8 +21,9 @@ per-call memory is the output; per-element work arrays have the size of one elem
 The tangent is either written as blocks ``(E, n, n)`` (:func:`layer_response`, the
 :mod:`beam_element.element` interface) or scattered straight into the values of the reduced CSR
 matrix through a precomputed slot map (:func:`layer_assemble`, used by the model), which skips
-the blocks and their concatenation. Layers with the ``membrane_average`` option use the NumPy
-path.
+the blocks and their concatenation. Layers with the ``membrane_average`` option (the faces'
+default) are evaluated by the kernel of :mod:`beam_element.averaged_kernel` (same arrays, ε_x
+averaged along η), or by the NumPy path where its assumptions fail (:func:`supports`).
 
 Layers whose rows factor into x- and z-functions at a tensor rule are evaluated instead by the
 sum-factorised kernel of :mod:`beam_element.sum_factor` (same integrand, same points, ξ summed
@@ -36,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from beam_element.averaged_kernel import averaged_kernel, averaging_weights
 from beam_element.layer_operators import LayerOperators
 from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
 from sandwich.solver.jit import njit
@@ -79,8 +81,13 @@ class KernelOperators:
 
 
 def supports(op: LayerOperators) -> bool:
-    """Whether the kernel evaluates ``op`` (not with the ``membrane_average`` option)."""
-    return not op.membrane_average
+    """Whether a kernel evaluates ``op``.
+
+    Every layer without the ``membrane_average`` option; with it, where
+    :func:`~beam_element.averaged_kernel.averaging_weights` accepts the rule and stiffness
+    (tensor rule with η slowest, separable weights, symmetric C: every layer the model builds).
+    """
+    return not op.membrane_average or averaging_weights(op) is not None
 
 
 def _packed_products(A0, A1, B0, B1, symmetric):
@@ -387,6 +394,14 @@ def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
     if lengths.shape != (u_l.shape[0],):
         raise ValueError(f"expected {u_l.shape[0]} element lengths, got {lengths.shape}")
     f = np.empty((u_l.shape[0], k.dofs.size))
+    if op.membrane_average:
+        wbar = averaging_weights(op)
+        if wbar is None:
+            raise ValueError(f"{op.name}: membrane_average needs a tensor rule and symmetric C")
+        averaged_kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww,
+                        k.Quw, k.pu, k.pw, k.ucols, k.wcols, k.x_slope, k.weight, wbar,
+                        k.stiffness, k.thickness, f, want_k, K_out, slots, signs, data)
+        return f
     if uses_sum_factorisation(op):
         fo = factored_operators(op)
         factored_kernel(u_l, lengths, float(width), fo.Xu, fo.Xdu, fo.ZuT, fo.ZduT, fo.iu,
@@ -412,7 +427,7 @@ def layer_response(
     Parameters
     ----------
     op
-        The layer (without ``membrane_average``, see :func:`supports`).
+        The layer (one the kernels evaluate, see :func:`supports`).
     u_e
         Element DOF vectors ``(E, n_element)`` (physical slopes), indexed by ``op.dofs``.
     lengths
@@ -423,7 +438,7 @@ def layer_response(
         Whether to compute the tangent.
     """
     if not supports(op):
-        raise ValueError("membrane_average layers use beam_element.element")
+        raise ValueError(f"{op.name}: not evaluated by the kernels, use beam_element.element")
     E, n = u_e.shape[0], op.dofs.size
     K = np.empty((E, n, n)) if tangent else _NO_BLOCKS
     f = _run(op, np.asarray(u_e)[:, op.dofs], lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS,
