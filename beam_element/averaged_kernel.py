@@ -26,6 +26,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from beam_element.kernel_blocks import (
+    emit_block,
+    gather_block,
+    scatter_force,
+    unpack_coupling,
+    unpack_symmetric,
+)
 from beam_element.layer_operators import LayerOperators
 from sandwich.solver.jit import njit
 
@@ -75,11 +82,7 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
     E = u_l.shape[0]
     G = weight.size
     n_eta, n_xi = wbar.shape
-    nu = ucols.size
-    nw = wcols.size
     n = x_slope.size
-    blocks = K_out.shape[0] > 0
-    scatter = slots.shape[0] > 0
     dz = 2.0 / thickness
     c00, c01, c02 = C[0, 0], C[0, 1], C[0, 2]
     c11, c12 = C[1, 1], C[1, 2]
@@ -94,17 +97,7 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
     yz = np.empty((n_xi, n))  # Σ_η dV (C_xz N̂ + C_xγ Ñ), then z = ½ C_xx W b + y
     for e0 in range(0, E, CHUNK):
         ec = min(CHUNK, E - e0)
-        scale = np.empty((ec, n))
-        Uu = np.empty((ec, nu))
-        Uw = np.empty((ec, nw))
-        for i in range(ec):
-            half = 0.5 * lengths[e0 + i]
-            for a in range(n):  # u_ref = scale ⊙ u_e: l/2 on x-slope DOFs
-                scale[i, a] = half if x_slope[a] else 1.0
-            for a in range(nu):
-                Uu[i, a] = u_l[e0 + i, ucols[a]] * scale[i, ucols[a]]
-            for a in range(nw):
-                Uw[i, a] = u_l[e0 + i, wcols[a]] * scale[i, wcols[a]]
+        scale, Uu, Uw = gather_block(u_l, lengths, e0, ec, x_slope, ucols, wcols)  # u_ref
         Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
         Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
         Cu = np.empty((ec, 2 * G))
@@ -201,11 +194,11 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
                 yn1 = dV * (c01 * p11 + c02 * p21)
                 ym0 = dV * c02 * p22
                 ym1 = dV * (c01 * p13 + c02 * p23)
-                for a in range(nu):
+                for a in range(ucols.size):
                     col = ucols[a]
                     bx[k, col] += wb * p00 * Nu[g, a]
                     yz[k, col] += yn0 * Nu[g, a] + yn1 * Nu[G + g, a]
-                for b in range(nw):
+                for b in range(wcols.size):
                     col = wcols[b]
                     bx[k, col] += wb * p02 * Mw[g, b]
                     yz[k, col] += ym0 * Mw[g, b] + ym1 * Mw[G + g, b]
@@ -217,13 +210,7 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
                     for a in range(n):
                         Kx[i, k, 0, a] = bx[k, a] * scale[i, a]
                         Kx[i, k, 1, a] = (0.5 * c00 * W * bx[k, a] + yz[k, a]) * scale[i, a]
-        Fu = np.dot(Cu, Nu)  # (ec, n_u)
-        Fw = np.dot(Cw, Mw)
-        for i in range(ec):
-            for a in range(nu):
-                f_out[e0 + i, ucols[a]] = Fu[i, a] * scale[i, ucols[a]]
-            for a in range(nw):
-                f_out[e0 + i, wcols[a]] = Fw[i, a] * scale[i, wcols[a]]
+        scatter_force(np.dot(Cu, Nu), np.dot(Cw, Mw), e0, ucols, wcols, scale, f_out)
         if not want_k:
             continue
         Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
@@ -231,26 +218,9 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
         Kww = np.dot(Hww, Qww)
         Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
         for i in range(ec):
-            e = e0 + i
-            for p in range(pu.shape[1]):
-                ia = ucols[pu[0, p]]
-                ib = ucols[pu[1, p]]
-                v = Kuu[i, p] * scale[i, ia] * scale[i, ib]
-                Ke[ia, ib] = v
-                Ke[ib, ia] = v
-            for p in range(pw.shape[1]):
-                ia = wcols[pw[0, p]]
-                ib = wcols[pw[1, p]]
-                v = Kww[i, p] * scale[i, ia] * scale[i, ib]
-                Ke[ia, ib] = v
-                Ke[ib, ia] = v
-            for a in range(nu):
-                ia = ucols[a]
-                for b in range(nw):
-                    ib = wcols[b]
-                    v = Kuw[i, a * nw + b] * scale[i, ia] * scale[i, ib]
-                    Ke[ia, ib] = v
-                    Ke[ib, ia] = v
+            unpack_symmetric(Kuu, i, pu, ucols, scale, Ke)
+            unpack_symmetric(Kww, i, pw, wcols, scale, Ke)
+            unpack_coupling(Kuw, i, ucols, wcols, scale, Ke)
             for k in range(n_xi):  # the B̄_x parts of eq. (24): b zᵀ + z bᵀ per ξ
                 for a in range(n):
                     ba = Kx[i, k, 0, a]
@@ -260,11 +230,4 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
                         Ke[a, b] += v
                         if b != a:
                             Ke[b, a] += v
-            if blocks:
-                K_out[e] = Ke
-            if scatter:
-                for a in range(n):
-                    for b in range(n):
-                        s = slots[e, a, b]
-                        if s >= 0:
-                            data[s] += signs[e, a, b] * Ke[a, b]
+            emit_block(e0 + i, Ke, K_out, slots, signs, data)

@@ -38,6 +38,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from beam_element.averaged_kernel import averaged_kernel, averaging_weights
+from beam_element.kernel_blocks import (
+    emit_block,
+    gather_block,
+    scatter_force,
+    unpack_coupling,
+    unpack_symmetric,
+)
 from beam_element.layer_operators import LayerOperators
 from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
 from sandwich.solver.jit import njit
@@ -160,28 +167,14 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
     """
     E = u_l.shape[0]
     G = weight.size
-    nu = ucols.size
-    nw = wcols.size
     n = x_slope.size
-    blocks = K_out.shape[0] > 0
-    scatter = slots.shape[0] > 0
     dz = 2.0 / thickness
     c00, c01, c02 = C[0, 0], C[0, 1], C[0, 2]
     c10, c11, c12 = C[1, 0], C[1, 1], C[1, 2]
     c20, c21, c22 = C[2, 0], C[2, 1], C[2, 2]
     for e0 in range(0, E, CHUNK):
         ec = min(CHUNK, E - e0)
-        scale = np.empty((ec, n))
-        Uu = np.empty((ec, nu))
-        Uw = np.empty((ec, nw))
-        for i in range(ec):
-            half = 0.5 * lengths[e0 + i]
-            for a in range(n):  # u_ref = scale ⊙ u_e: l/2 on x-slope DOFs
-                scale[i, a] = half if x_slope[a] else 1.0
-            for a in range(nu):
-                Uu[i, a] = u_l[e0 + i, ucols[a]] * scale[i, ucols[a]]
-            for a in range(nw):
-                Uw[i, a] = u_l[e0 + i, wcols[a]] * scale[i, wcols[a]]
+        scale, Uu, Uw = gather_block(u_l, lengths, e0, ec, x_slope, ucols, wcols)  # u_ref
         Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
         Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
         Cu = np.empty((ec, 2 * G))
@@ -251,13 +244,7 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
                 Huw[i, G + g] = dV * (p00 * a03 + p20 * a23)  # H03
                 Huw[i, 2 * G + g] = dV * (p11 * a12 + p21 * a22)  # H12
                 Huw[i, 3 * G + g] = dV * (p11 * a13 + p21 * a23)  # H13
-        Fu = np.dot(Cu, Nu)  # (ec, n_u)
-        Fw = np.dot(Cw, Mw)
-        for i in range(ec):
-            for a in range(nu):
-                f_out[e0 + i, ucols[a]] = Fu[i, a] * scale[i, ucols[a]]
-            for a in range(nw):
-                f_out[e0 + i, wcols[a]] = Fw[i, a] * scale[i, wcols[a]]
+        scatter_force(np.dot(Cu, Nu), np.dot(Cw, Mw), e0, ucols, wcols, scale, f_out)
         if not want_k:
             continue
         Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
@@ -265,35 +252,11 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
         Kww = np.dot(Hww, Qww)
         Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
         for i in range(ec):
-            e = e0 + i
             # every entry (physical: scaled) into the element's dense block, then out
-            for p in range(pu.shape[1]):
-                ia = ucols[pu[0, p]]
-                ib = ucols[pu[1, p]]
-                v = Kuu[i, p] * scale[i, ia] * scale[i, ib]
-                Ke[ia, ib] = v
-                Ke[ib, ia] = v
-            for p in range(pw.shape[1]):
-                ia = wcols[pw[0, p]]
-                ib = wcols[pw[1, p]]
-                v = Kww[i, p] * scale[i, ia] * scale[i, ib]
-                Ke[ia, ib] = v
-                Ke[ib, ia] = v
-            for a in range(nu):
-                ia = ucols[a]
-                for b in range(nw):
-                    ib = wcols[b]
-                    v = Kuw[i, a * nw + b] * scale[i, ia] * scale[i, ib]
-                    Ke[ia, ib] = v
-                    Ke[ib, ia] = v
-            if blocks:
-                K_out[e] = Ke
-            if scatter:
-                for a in range(n):
-                    for b in range(n):
-                        s = slots[e, a, b]
-                        if s >= 0:
-                            data[s] += signs[e, a, b] * Ke[a, b]
+            unpack_symmetric(Kuu, i, pu, ucols, scale, Ke)
+            unpack_symmetric(Kww, i, pw, wcols, scale, Ke)
+            unpack_coupling(Kuw, i, ucols, wcols, scale, Ke)
+            emit_block(e0 + i, Ke, K_out, slots, signs, data)
 
 
 @njit
