@@ -26,13 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from beam_element.kernel_blocks import (
-    emit_block,
-    gather_block,
-    scatter_force,
-    unpack_coupling,
-    unpack_symmetric,
-)
+from beam_element import kernel_blocks as kb
 from beam_element.layer_operators import LayerOperators
 from sandwich.solver.jit import njit
 
@@ -97,29 +91,14 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
     yz = np.empty((n_xi, n))  # Σ_η dV (C_xz N̂ + C_xγ Ñ), then z = ½ C_xx W b + y
     for e0 in range(0, E, CHUNK):
         ec = min(CHUNK, E - e0)
-        scale, Uu, Uw = gather_block(u_l, lengths, e0, ec, x_slope, ucols, wcols)  # u_ref
-        Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
-        Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
-        Cu = np.empty((ec, 2 * G))
-        Cw = np.empty((ec, 2 * G))
-        if want_k:
-            Huu = np.empty((ec, 3 * G))
-            Hww = np.empty((ec, 3 * G))
-            Huw = np.empty((ec, 4 * G))
-            Kx = np.empty((ec, n_xi, 2, n))  # per element and ξ: b and z
-        else:
-            Huu = np.empty((0, 0))
-            Hww = np.empty((0, 0))
-            Huw = np.empty((0, 0))
-            Kx = np.empty((0, 0, 0, 0))
+        scale, Du, Dw, Cu, Cw, Huu, Hww, Huw = kb.open_block(u_l, lengths, e0, ec, x_slope, ucols,
+                                                          wcols, NuT, MwT, want_k)
+        Kx = np.empty((ec if want_k else 0, n_xi, 2, n))  # per element and ξ: b and z
         for i in range(ec):
             dx = 2.0 / lengths[e0 + i]
             dV0 = width * (0.5 * lengths[e0 + i]) * (0.5 * thickness)  # b l h / 4, eq. (19)
             for g in range(G):
-                ux = dx * Du[i, g]  # eq. (15)
-                uz = dz * Du[i, G + g]
-                wx = dx * Dw[i, g]
-                wz = dz * Dw[i, G + g]
+                ux, uz, wx, wz = kb.point_gradients(Du, Dw, i, g, dx, dz)  # eq. (15)
                 ex[g] = ux + 0.5 * (ux * ux + wx * wx)  # Green-Lagrange, eq. (15)
                 ez[g] = wz + 0.5 * (uz * uz + wz * wz)
                 gm[g] = uz + wx + ux * uz + wx * wz
@@ -141,32 +120,19 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
             for g in range(G):
                 j = g // n_xi
                 k = g % n_xi
-                ux = dx * Du[i, g]
-                uz = dz * Du[i, G + g]
-                wx = dx * Dw[i, g]
-                wz = dz * Dw[i, G + g]
+                ux, uz, wx, wz = kb.point_gradients(Du, Dw, i, g, dx, dz)
                 dV = dV0 * weight[g]
                 e_x = exbar[k]
                 sb = dV * (C[1, 0] * e_x + c11 * ez[g] + c12 * gm[g])  # dV σ, eq. (3)
                 st = dV * (C[2, 0] * e_x + c21 * ez[g] + c22 * gm[g])
                 sadj = wbar[j, k] * sasum[k]  # adjoint of the η-mean on dV σ_x
                 # eq. (19): Σ_g dV σ·B̄ = Σ_g c·R, σ_x's coefficient moved by the adjoint
-                Cu[i, g] = dx * (sadj * (1 + ux) + st * uz)
-                Cu[i, G + g] = dz * (sb * uz + st * (1 + ux))
-                Cw[i, g] = dx * (sadj * wx + st * (1 + wz))
-                Cw[i, G + g] = dz * (sb * (1 + wz) + st * wx)
+                Cu[i, g], Cu[i, G + g], Cw[i, g], Cw[i, G + g] = kb.force_coefficients(
+                    dx, dz, sadj, sb, st, ux, uz, wx, wz)
                 if not want_k:
                     continue
-                # Φ of strain_coefficients (B = Φ R, eq. 17): rows (p00 0 p02 0),
-                # (0 p11 0 p13), (p20 p21 p22 p23)
-                p00 = dx * (1 + ux)
-                p02 = dx * wx
-                p11 = dz * uz
-                p13 = dz * (1 + wz)
-                p20 = dx * uz
-                p21 = dz * (1 + ux)
-                p22 = dx * (1 + wz)
-                p23 = dz * wx
+                # Φ (B = Φ R, eq. 17)
+                p00, p02, p11, p13, p20, p21, p22, p23 = kb.strain_factors(dx, dz, ux, uz, wx, wz)
                 # (z, γ) rows of CΦ restricted to the (z, γ) rows of Φ: pointwise part of eq. (24)
                 a11 = c11 * p11 + c12 * p21
                 a12 = c12 * p22
@@ -210,17 +176,13 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
                     for a in range(n):
                         Kx[i, k, 0, a] = bx[k, a] * scale[i, a]
                         Kx[i, k, 1, a] = (0.5 * c00 * W * bx[k, a] + yz[k, a]) * scale[i, a]
-        scatter_force(np.dot(Cu, Nu), np.dot(Cw, Mw), e0, ucols, wcols, scale, f_out)
+        kb.scatter_force(np.dot(Cu, Nu), np.dot(Cw, Mw), e0, ucols, wcols, scale, f_out)
         if not want_k:
             continue
-        Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
+        Kuu, Kww, Kuw = kb.packed_tangents(Huu, Hww, Huw, Quu, Qww, Quw)
         Ke = np.empty((n, n))
-        Kww = np.dot(Hww, Qww)
-        Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
         for i in range(ec):
-            unpack_symmetric(Kuu, i, pu, ucols, scale, Ke)
-            unpack_symmetric(Kww, i, pw, wcols, scale, Ke)
-            unpack_coupling(Kuw, i, ucols, wcols, scale, Ke)
+            kb.unpack_element(i, Kuu, Kww, Kuw, pu, pw, ucols, wcols, scale, Ke)
             for k in range(n_xi):  # the B̄_x parts of eq. (24): b zᵀ + z bᵀ per ξ
                 for a in range(n):
                     ba = Kx[i, k, 0, a]
@@ -230,4 +192,4 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
                         Ke[a, b] += v
                         if b != a:
                             Ke[b, a] += v
-            emit_block(e0 + i, Ke, K_out, slots, signs, data)
+            kb.emit_block(e0 + i, Ke, K_out, slots, signs, data)

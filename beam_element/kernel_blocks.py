@@ -1,4 +1,4 @@
-"""Gather and unpack steps shared by the packed layer kernels (compiled).
+"""Steps shared by the packed layer kernels (compiled): gather, per-point factors, unpack.
 
 :func:`beam_element.kernels._kernel` and :func:`beam_element.averaged_kernel.averaged_kernel`
 work on blocks of elements in the same layout: the layer's DOF values split into u and w
@@ -13,7 +13,30 @@ import numpy as np
 
 from sandwich.solver.jit import njit
 
-__all__ = ["emit_block", "gather_block", "scatter_force", "unpack_coupling", "unpack_symmetric"]
+__all__ = ["emit_block", "force_coefficients", "gather_block", "open_block", "packed_tangents",
+           "point_gradients", "scatter_force", "strain_factors", "unpack_element"]
+
+
+@njit
+def force_coefficients(dx, dz, sa, sb, st, ux, uz, wx, wz):  # pragma: no cover - compiled
+    """Coefficients of the rows N,η  N,ξ  M,η  M,ξ in a point's force, eq. (19).
+
+    Σ_g dV σ·B = Σ_g c·R with the rows of eq. (17) sorted by R; ``sa, sb, st`` are dV (σ_x,
+    σ_z, τ) (σ_x's coefficient as the force sees it: adjoint-averaged with membrane_average).
+    """
+    return (dx * (sa * (1 + ux) + st * uz), dz * (sb * uz + st * (1 + ux)),
+            dx * (sa * wx + st * (1 + wz)), dz * (sb * (1 + wz) + st * wx))
+
+
+@njit
+def strain_factors(dx, dz, ux, uz, wx, wz):  # pragma: no cover - compiled
+    """Non-zero entries of Φ (B = Φ R, eq. 17), as in ``kinematics.strain_coefficients``.
+
+    Rows (p00 0 p02 0), (0 p11 0 p13), (p20 p21 p22 p23), returned as
+    (p00, p02, p11, p13, p20, p21, p22, p23).
+    """
+    return (dx * (1 + ux), dx * wx, dz * uz, dz * (1 + wz),
+            dx * uz, dz * (1 + ux), dx * (1 + wz), dz * wx)
 
 
 @njit
@@ -35,6 +58,39 @@ def gather_block(u_l, lengths, e0, ec, x_slope, ucols, wcols):  # pragma: no cov
         for a in range(wcols.size):
             Uw[i, a] = u_l[e0 + i, wcols[a]] * scale[i, wcols[a]]
     return scale, Uu, Uw
+
+
+@njit
+def open_block(u_l, lengths, e0, ec, x_slope, ucols, wcols, NuT, MwT,
+               want_k):  # pragma: no cover - compiled
+    """A block's ``scale``, gradients ``Du``, ``Dw`` (reference) and its work arrays.
+
+    ``Du = [N,η u | N,ξ u]``, ``Dw = [M,η w | M,ξ w]`` (ec, 2G), one GEMM each; force
+    coefficients ``Cu``, ``Cw`` (ec, 2G) and, if ``want_k``, the point matrices ``Huu``,
+    ``Hww`` (ec, 3G) and ``Huw`` (ec, 4G) (else empty).
+    """
+    scale, Uu, Uw = gather_block(u_l, lengths, e0, ec, x_slope, ucols, wcols)  # u_ref
+    G = NuT.shape[1] // 2
+    Du = np.dot(Uu, NuT)
+    Dw = np.dot(Uw, MwT)
+    Cu = np.empty((ec, 2 * G))
+    Cw = np.empty((ec, 2 * G))
+    if want_k:
+        Huu = np.empty((ec, 3 * G))
+        Hww = np.empty((ec, 3 * G))
+        Huw = np.empty((ec, 4 * G))
+    else:
+        Huu = np.empty((0, 0))
+        Hww = np.empty((0, 0))
+        Huw = np.empty((0, 0))
+    return scale, Du, Dw, Cu, Cw, Huu, Hww, Huw
+
+
+@njit
+def point_gradients(Du, Dw, i, g, dx, dz):  # pragma: no cover - compiled
+    """u,x  u,z  w,x  w,z of element i at point g (eq. 15) from the block's gradients."""
+    G = Du.shape[1] // 2
+    return dx * Du[i, g], dz * Du[i, G + g], dx * Dw[i, g], dz * Dw[i, G + g]
 
 
 @njit
@@ -69,6 +125,20 @@ def unpack_coupling(Kuw, i, ucols, wcols, scale, Ke):  # pragma: no cover - comp
             v = Kuw[i, a * nw + b] * scale[i, ia] * scale[i, ib]
             Ke[ia, ib] = v
             Ke[ib, ia] = v
+
+
+@njit
+def packed_tangents(Huu, Hww, Huw, Quu, Qww, Quw):  # pragma: no cover - compiled
+    """The block's packed tangents: ``H · Q`` for uu, ww (upper triangles) and uw, one GEMM each."""
+    return np.dot(Huu, Quu), np.dot(Hww, Qww), np.dot(Huw, Quw)
+
+
+@njit
+def unpack_element(i, Kuu, Kww, Kuw, pu, pw, ucols, wcols, scale, Ke):  # pragma: no cover
+    """Element i's packed tangents into its dense block ``Ke`` (physical: scaled by l/2)."""
+    unpack_symmetric(Kuu, i, pu, ucols, scale, Ke)
+    unpack_symmetric(Kww, i, pw, wcols, scale, Ke)
+    unpack_coupling(Kuw, i, ucols, wcols, scale, Ke)
 
 
 @njit

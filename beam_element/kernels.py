@@ -40,10 +40,13 @@ import numpy as np
 from beam_element.averaged_kernel import averaged_kernel, averaging_weights
 from beam_element.kernel_blocks import (
     emit_block,
-    gather_block,
+    force_coefficients,
+    open_block,
+    packed_tangents,
+    point_gradients,
     scatter_force,
-    unpack_coupling,
-    unpack_symmetric,
+    strain_factors,
+    unpack_element,
 )
 from beam_element.layer_operators import LayerOperators
 from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
@@ -174,27 +177,13 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
     c20, c21, c22 = C[2, 0], C[2, 1], C[2, 2]
     for e0 in range(0, E, CHUNK):
         ec = min(CHUNK, E - e0)
-        scale, Uu, Uw = gather_block(u_l, lengths, e0, ec, x_slope, ucols, wcols)  # u_ref
-        Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
-        Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
-        Cu = np.empty((ec, 2 * G))
-        Cw = np.empty((ec, 2 * G))
-        if want_k:
-            Huu = np.empty((ec, 3 * G))
-            Hww = np.empty((ec, 3 * G))
-            Huw = np.empty((ec, 4 * G))
-        else:
-            Huu = np.empty((0, 0))
-            Hww = np.empty((0, 0))
-            Huw = np.empty((0, 0))
+        scale, Du, Dw, Cu, Cw, Huu, Hww, Huw = open_block(u_l, lengths, e0, ec, x_slope, ucols,
+                                                          wcols, NuT, MwT, want_k)
         for i in range(ec):
             dx = 2.0 / lengths[e0 + i]
             dV0 = width * (0.5 * lengths[e0 + i]) * (0.5 * thickness)  # b l h / 4, eq. (19)
             for g in range(G):
-                ux = dx * Du[i, g]  # eq. (15)
-                uz = dz * Du[i, G + g]
-                wx = dx * Dw[i, g]
-                wz = dz * Dw[i, G + g]
+                ux, uz, wx, wz = point_gradients(Du, Dw, i, g, dx, dz)  # eq. (15)
                 ex = ux + 0.5 * (ux * ux + wx * wx)  # Green-Lagrange, eq. (15)
                 ez = wz + 0.5 * (uz * uz + wz * wz)
                 gm = uz + wx + ux * uz + wx * wz
@@ -203,22 +192,12 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
                 sb = dV * (c10 * ex + c11 * ez + c12 * gm)
                 st = dV * (c20 * ex + c21 * ez + c22 * gm)
                 # eq. (19): Σ_g dV σ·B = Σ_g c·R, the rows of eq. (17) sorted by R
-                Cu[i, g] = dx * (sa * (1 + ux) + st * uz)
-                Cu[i, G + g] = dz * (sb * uz + st * (1 + ux))
-                Cw[i, g] = dx * (sa * wx + st * (1 + wz))
-                Cw[i, G + g] = dz * (sb * (1 + wz) + st * wx)
+                Cu[i, g], Cu[i, G + g], Cw[i, g], Cw[i, G + g] = force_coefficients(
+                    dx, dz, sa, sb, st, ux, uz, wx, wz)
                 if not want_k:
                     continue
-                # Φ of strain_coefficients (B = Φ R, eq. 17): rows (p00 0 p02 0),
-                # (0 p11 0 p13), (p20 p21 p22 p23)
-                p00 = dx * (1 + ux)
-                p02 = dx * wx
-                p11 = dz * uz
-                p13 = dz * (1 + wz)
-                p20 = dx * uz
-                p21 = dz * (1 + ux)
-                p22 = dx * (1 + wz)
-                p23 = dz * wx
+                # Φ (B = Φ R, eq. 17)
+                p00, p02, p11, p13, p20, p21, p22, p23 = strain_factors(dx, dz, ux, uz, wx, wz)
                 a00 = c00 * p00 + c02 * p20  # CΦ
                 a01 = c01 * p11 + c02 * p21
                 a02 = c00 * p02 + c02 * p22
@@ -247,15 +226,11 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
         scatter_force(np.dot(Cu, Nu), np.dot(Cw, Mw), e0, ucols, wcols, scale, f_out)
         if not want_k:
             continue
-        Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
+        Kuu, Kww, Kuw = packed_tangents(Huu, Hww, Huw, Quu, Qww, Quw)
         Ke = np.empty((n, n))
-        Kww = np.dot(Hww, Qww)
-        Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
         for i in range(ec):
             # every entry (physical: scaled) into the element's dense block, then out
-            unpack_symmetric(Kuu, i, pu, ucols, scale, Ke)
-            unpack_symmetric(Kww, i, pw, wcols, scale, Ke)
-            unpack_coupling(Kuw, i, ucols, wcols, scale, Ke)
+            unpack_element(i, Kuu, Kww, Kuw, pu, pw, ucols, wcols, scale, Ke)
             emit_block(e0 + i, Ke, K_out, slots, signs, data)
 
 

@@ -34,6 +34,19 @@ def _rel(a, b):
     return np.max(np.abs(a - b)) / np.max(np.abs(b))
 
 
+def _assert_kernel_matches_numpy(op, u, lengths):
+    """Kernel force and tangent = NumPy path's to 1e-13; tangent symmetric; force-only call the
+    same force. Returns the NumPy tangent."""
+    f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
+    f, K = kernels.layer_response(op, u, lengths, 60.0)
+    assert _rel(f, f_ref) < 1e-13
+    assert _rel(K, K_ref) < 1e-13
+    assert np.array_equal(K, K.transpose(0, 2, 1))  # symmetric by construction
+    f_only, none = kernels.layer_response(op, u, lengths, 60.0, tangent=False)
+    assert none is None and np.array_equal(f_only, f)
+    return K_ref
+
+
 @pytest.mark.parametrize("name,h,C", LAYERS)
 @pytest.mark.parametrize("gauss", ["exact", (3, 2), (9, 8)])
 def test_kernel_matches_numpy_reference(name, h, C, gauss):
@@ -43,13 +56,7 @@ def test_kernel_matches_numpy_reference(name, h, C, gauss):
     E = 300  # more than one kernel block (CHUNK = 128), last one partial
     u = rng.normal(size=(E, 40)) * 0.5
     lengths = rng.uniform(1.0, 9.0, size=E)
-    f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
-    f, K = kernels.layer_response(op, u, lengths, 60.0)
-    assert _rel(f, f_ref) < 1e-13
-    assert _rel(K, K_ref) < 1e-13
-    assert np.array_equal(K, K.transpose(0, 2, 1))  # symmetric by construction
-    f_only, none = kernels.layer_response(op, u, lengths, 60.0, tangent=False)
-    assert none is None and np.array_equal(f_only, f)
+    _assert_kernel_matches_numpy(op, u, lengths)
 
 
 def _full_symmetric_stiffness(rng):
@@ -74,13 +81,7 @@ def test_averaged_membrane_kernel_matches_numpy_reference(name, stretch, coupled
     E = 300  # more than one kernel block (CHUNK = 128), last one partial
     u = rng.normal(size=(E, 42)) * 0.5
     lengths = rng.uniform(1.0, 9.0, size=E)
-    f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
-    f, K = kernels.layer_response(op, u, lengths, 60.0)
-    assert _rel(f, f_ref) < 1e-13
-    assert _rel(K, K_ref) < 1e-13
-    assert np.array_equal(K, K.transpose(0, 2, 1))
-    f_only, none = kernels.layer_response(op, u, lengths, 60.0, tangent=False)
-    assert none is None and np.array_equal(f_only, f)
+    K_ref = _assert_kernel_matches_numpy(op, u, lengths)
     # the averaging changes the answer (the test would not see a kernel ignoring it)
     plain = replace(op, membrane_average=False)
     assert _rel(kernels.layer_response(plain, u, lengths, 60.0)[1], K_ref) > 1e-3
