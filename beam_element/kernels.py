@@ -21,8 +21,9 @@ per-call memory is the output; per-element work arrays have the size of one elem
 The tangent is either written as blocks ``(E, n, n)`` (:func:`layer_response`, the
 :mod:`beam_element.element` interface) or scattered straight into the values of the reduced CSR
 matrix through a precomputed slot map (:func:`layer_assemble`, used by the model), which skips
-the blocks and their concatenation. Layers with the ``membrane_average`` option use the NumPy
-path.
+the blocks and their concatenation. Layers with the ``membrane_average`` option (the faces'
+default) are evaluated by the kernel of :mod:`beam_element.averaged_kernel` (same arrays, ε_x
+averaged along η), or by the NumPy path where its assumptions fail (:func:`supports`).
 
 Layers whose rows factor into x- and z-functions at a tensor rule are evaluated instead by the
 sum-factorised kernel of :mod:`beam_element.sum_factor` (same integrand, same points, ξ summed
@@ -36,6 +37,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from beam_element.averaged_kernel import averaged_kernel, averaging_weights
+from beam_element.kernel_blocks import (
+    emit_block,
+    force_coefficients,
+    open_block,
+    packed_tangents,
+    point_gradients,
+    scatter_force,
+    strain_factors,
+    unpack_element,
+)
 from beam_element.layer_operators import LayerOperators
 from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
 from sandwich.solver.jit import njit
@@ -79,8 +91,13 @@ class KernelOperators:
 
 
 def supports(op: LayerOperators) -> bool:
-    """Whether the kernel evaluates ``op`` (not with the ``membrane_average`` option)."""
-    return not op.membrane_average
+    """Whether a kernel evaluates ``op``.
+
+    Every layer without the ``membrane_average`` option; with it, where
+    :func:`~beam_element.averaged_kernel.averaging_weights` accepts the rule and stiffness
+    (tensor rule with η slowest, separable weights, symmetric C: every layer the model builds).
+    """
+    return not op.membrane_average or averaging_weights(op) is not None
 
 
 def _packed_products(A0, A1, B0, B1, symmetric):
@@ -153,48 +170,20 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
     """
     E = u_l.shape[0]
     G = weight.size
-    nu = ucols.size
-    nw = wcols.size
     n = x_slope.size
-    blocks = K_out.shape[0] > 0
-    scatter = slots.shape[0] > 0
     dz = 2.0 / thickness
     c00, c01, c02 = C[0, 0], C[0, 1], C[0, 2]
     c10, c11, c12 = C[1, 0], C[1, 1], C[1, 2]
     c20, c21, c22 = C[2, 0], C[2, 1], C[2, 2]
     for e0 in range(0, E, CHUNK):
         ec = min(CHUNK, E - e0)
-        scale = np.empty((ec, n))
-        Uu = np.empty((ec, nu))
-        Uw = np.empty((ec, nw))
-        for i in range(ec):
-            half = 0.5 * lengths[e0 + i]
-            for a in range(n):  # u_ref = scale ⊙ u_e: l/2 on x-slope DOFs
-                scale[i, a] = half if x_slope[a] else 1.0
-            for a in range(nu):
-                Uu[i, a] = u_l[e0 + i, ucols[a]] * scale[i, ucols[a]]
-            for a in range(nw):
-                Uw[i, a] = u_l[e0 + i, wcols[a]] * scale[i, wcols[a]]
-        Du = np.dot(Uu, NuT)  # (ec, 2G): N,η u | N,ξ u
-        Dw = np.dot(Uw, MwT)  # M,η w | M,ξ w
-        Cu = np.empty((ec, 2 * G))
-        Cw = np.empty((ec, 2 * G))
-        if want_k:
-            Huu = np.empty((ec, 3 * G))
-            Hww = np.empty((ec, 3 * G))
-            Huw = np.empty((ec, 4 * G))
-        else:
-            Huu = np.empty((0, 0))
-            Hww = np.empty((0, 0))
-            Huw = np.empty((0, 0))
+        scale, Du, Dw, Cu, Cw, Huu, Hww, Huw = open_block(u_l, lengths, e0, ec, x_slope, ucols,
+                                                          wcols, NuT, MwT, want_k)
         for i in range(ec):
             dx = 2.0 / lengths[e0 + i]
             dV0 = width * (0.5 * lengths[e0 + i]) * (0.5 * thickness)  # b l h / 4, eq. (19)
             for g in range(G):
-                ux = dx * Du[i, g]  # eq. (15)
-                uz = dz * Du[i, G + g]
-                wx = dx * Dw[i, g]
-                wz = dz * Dw[i, G + g]
+                ux, uz, wx, wz = point_gradients(Du, Dw, i, g, dx, dz)  # eq. (15)
                 ex = ux + 0.5 * (ux * ux + wx * wx)  # Green-Lagrange, eq. (15)
                 ez = wz + 0.5 * (uz * uz + wz * wz)
                 gm = uz + wx + ux * uz + wx * wz
@@ -203,22 +192,12 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
                 sb = dV * (c10 * ex + c11 * ez + c12 * gm)
                 st = dV * (c20 * ex + c21 * ez + c22 * gm)
                 # eq. (19): Σ_g dV σ·B = Σ_g c·R, the rows of eq. (17) sorted by R
-                Cu[i, g] = dx * (sa * (1 + ux) + st * uz)
-                Cu[i, G + g] = dz * (sb * uz + st * (1 + ux))
-                Cw[i, g] = dx * (sa * wx + st * (1 + wz))
-                Cw[i, G + g] = dz * (sb * (1 + wz) + st * wx)
+                Cu[i, g], Cu[i, G + g], Cw[i, g], Cw[i, G + g] = force_coefficients(
+                    dx, dz, sa, sb, st, ux, uz, wx, wz)
                 if not want_k:
                     continue
-                # Φ of strain_coefficients (B = Φ R, eq. 17): rows (p00 0 p02 0),
-                # (0 p11 0 p13), (p20 p21 p22 p23)
-                p00 = dx * (1 + ux)
-                p02 = dx * wx
-                p11 = dz * uz
-                p13 = dz * (1 + wz)
-                p20 = dx * uz
-                p21 = dz * (1 + ux)
-                p22 = dx * (1 + wz)
-                p23 = dz * wx
+                # Φ (B = Φ R, eq. 17)
+                p00, p02, p11, p13, p20, p21, p22, p23 = strain_factors(dx, dz, ux, uz, wx, wz)
                 a00 = c00 * p00 + c02 * p20  # CΦ
                 a01 = c01 * p11 + c02 * p21
                 a02 = c00 * p02 + c02 * p22
@@ -244,49 +223,15 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
                 Huw[i, G + g] = dV * (p00 * a03 + p20 * a23)  # H03
                 Huw[i, 2 * G + g] = dV * (p11 * a12 + p21 * a22)  # H12
                 Huw[i, 3 * G + g] = dV * (p11 * a13 + p21 * a23)  # H13
-        Fu = np.dot(Cu, Nu)  # (ec, n_u)
-        Fw = np.dot(Cw, Mw)
-        for i in range(ec):
-            for a in range(nu):
-                f_out[e0 + i, ucols[a]] = Fu[i, a] * scale[i, ucols[a]]
-            for a in range(nw):
-                f_out[e0 + i, wcols[a]] = Fw[i, a] * scale[i, wcols[a]]
+        scatter_force(np.dot(Cu, Nu), np.dot(Cw, Mw), e0, ucols, wcols, scale, f_out)
         if not want_k:
             continue
-        Kuu = np.dot(Huu, Quu)  # (ec, n_u (n_u + 1) / 2)
+        Kuu, Kww, Kuw = packed_tangents(Huu, Hww, Huw, Quu, Qww, Quw)
         Ke = np.empty((n, n))
-        Kww = np.dot(Hww, Qww)
-        Kuw = np.dot(Huw, Quw)  # (ec, n_u n_w)
         for i in range(ec):
-            e = e0 + i
             # every entry (physical: scaled) into the element's dense block, then out
-            for p in range(pu.shape[1]):
-                ia = ucols[pu[0, p]]
-                ib = ucols[pu[1, p]]
-                v = Kuu[i, p] * scale[i, ia] * scale[i, ib]
-                Ke[ia, ib] = v
-                Ke[ib, ia] = v
-            for p in range(pw.shape[1]):
-                ia = wcols[pw[0, p]]
-                ib = wcols[pw[1, p]]
-                v = Kww[i, p] * scale[i, ia] * scale[i, ib]
-                Ke[ia, ib] = v
-                Ke[ib, ia] = v
-            for a in range(nu):
-                ia = ucols[a]
-                for b in range(nw):
-                    ib = wcols[b]
-                    v = Kuw[i, a * nw + b] * scale[i, ia] * scale[i, ib]
-                    Ke[ia, ib] = v
-                    Ke[ib, ia] = v
-            if blocks:
-                K_out[e] = Ke
-            if scatter:
-                for a in range(n):
-                    for b in range(n):
-                        s = slots[e, a, b]
-                        if s >= 0:
-                            data[s] += signs[e, a, b] * Ke[a, b]
+            unpack_element(i, Kuu, Kww, Kuw, pu, pw, ucols, wcols, scale, Ke)
+            emit_block(e0 + i, Ke, K_out, slots, signs, data)
 
 
 @njit
@@ -387,6 +332,14 @@ def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
     if lengths.shape != (u_l.shape[0],):
         raise ValueError(f"expected {u_l.shape[0]} element lengths, got {lengths.shape}")
     f = np.empty((u_l.shape[0], k.dofs.size))
+    if op.membrane_average:
+        wbar = averaging_weights(op)
+        if wbar is None:
+            raise ValueError(f"{op.name}: membrane_average needs a tensor rule and symmetric C")
+        averaged_kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww,
+                        k.Quw, k.pu, k.pw, k.ucols, k.wcols, k.x_slope, k.weight, wbar,
+                        k.stiffness, k.thickness, f, want_k, K_out, slots, signs, data)
+        return f
     if uses_sum_factorisation(op):
         fo = factored_operators(op)
         factored_kernel(u_l, lengths, float(width), fo.Xu, fo.Xdu, fo.ZuT, fo.ZduT, fo.iu,
@@ -412,7 +365,7 @@ def layer_response(
     Parameters
     ----------
     op
-        The layer (without ``membrane_average``, see :func:`supports`).
+        The layer (one the kernels evaluate, see :func:`supports`).
     u_e
         Element DOF vectors ``(E, n_element)`` (physical slopes), indexed by ``op.dofs``.
     lengths
@@ -423,7 +376,7 @@ def layer_response(
         Whether to compute the tangent.
     """
     if not supports(op):
-        raise ValueError("membrane_average layers use beam_element.element")
+        raise ValueError(f"{op.name}: not evaluated by the kernels, use beam_element.element")
     E, n = u_e.shape[0], op.dofs.size
     K = np.empty((E, n, n)) if tangent else _NO_BLOCKS
     f = _run(op, np.asarray(u_e)[:, op.dofs], lengths, width, tangent, K, _NO_SLOTS, _NO_SIGNS,

@@ -4,7 +4,10 @@ References: the NumPy path of beam_element.element (force of eq. 19, tangent of 
 as the reference implementation, to round-off; central finite differences of the kernel's own
 force for its tangent; and the model's NumPy path (use_kernels = False) for the assembled force
 and reduced tangent, with debonds, contact and core levels > 1. Genericity in the layer's DOF
-count n and point count G: a synthetic layer with extra DOFs and a non-tensor rule.
+count n and point count G: a synthetic layer with extra DOFs and a non-tensor rule. The averaged
+face membrane (beam_element.averaged_kernel) against the same NumPy path, with and without the
+face stretch DOF, with the faces' diagonal C and a full symmetric C, and its assembled model
+tangent against central finite differences of the model's force.
 """
 
 from dataclasses import replace
@@ -17,7 +20,7 @@ from beam_scenes import KEVLAR, ROHACELL, Debond, sandwich_scene  # noqa: I001
 
 from beam_element import element, kernels
 from beam_element.constitutive import core_stiffness, face_stiffness
-from beam_element.layer_operators import build_layer_operators
+from beam_element.layer_operators import build_face_operators, build_layer_operators
 from beam_element.model import build_model
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.solver.envelope import EnvelopeFactorization
@@ -31,6 +34,19 @@ def _rel(a, b):
     return np.max(np.abs(a - b)) / np.max(np.abs(b))
 
 
+def _assert_kernel_matches_numpy(op, u, lengths):
+    """Kernel force and tangent = NumPy path's to 1e-13; tangent symmetric; force-only call the
+    same force. Returns the NumPy tangent."""
+    f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
+    f, K = kernels.layer_response(op, u, lengths, 60.0)
+    assert _rel(f, f_ref) < 1e-13
+    assert _rel(K, K_ref) < 1e-13
+    assert np.array_equal(K, K.transpose(0, 2, 1))  # symmetric by construction
+    f_only, none = kernels.layer_response(op, u, lengths, 60.0, tangent=False)
+    assert none is None and np.array_equal(f_only, f)
+    return K_ref
+
+
 @pytest.mark.parametrize("name,h,C", LAYERS)
 @pytest.mark.parametrize("gauss", ["exact", (3, 2), (9, 8)])
 def test_kernel_matches_numpy_reference(name, h, C, gauss):
@@ -40,13 +56,59 @@ def test_kernel_matches_numpy_reference(name, h, C, gauss):
     E = 300  # more than one kernel block (CHUNK = 128), last one partial
     u = rng.normal(size=(E, 40)) * 0.5
     lengths = rng.uniform(1.0, 9.0, size=E)
+    _assert_kernel_matches_numpy(op, u, lengths)
+
+
+def _full_symmetric_stiffness(rng):
+    """A positive-definite C with every coupling (C_xz, C_xγ, C_zγ) non-zero (MPa)."""
+    A = rng.normal(size=(3, 3))
+    return 100.0 * (A @ A.T) + 50.0 * np.eye(3)
+
+
+@pytest.mark.parametrize("name", ["top", "bottom"])
+@pytest.mark.parametrize("stretch", [False, True])
+@pytest.mark.parametrize("coupled", [False, True])
+def test_averaged_membrane_kernel_matches_numpy_reference(name, stretch, coupled):
+    rng = np.random.default_rng(17)
+    C = face_stiffness(KEVLAR).copy()
+    if stretch:  # the stretch faces' σ_z = E ε_z (build_model)
+        C[1, 1] = C[0, 0]
+    if coupled:  # not a face law: exercises the C_xz, C_xγ terms of the B̄_x update
+        C = _full_symmetric_stiffness(rng)
+    op = build_face_operators(name, 0.5, 0.0, C, gauss=EXACT_ORDER[name],
+                              membrane_average=True, stretch=stretch)
+    assert op.membrane_average and kernels.supports(op)
+    E = 300  # more than one kernel block (CHUNK = 128), last one partial
+    u = rng.normal(size=(E, 42)) * 0.5
+    lengths = rng.uniform(1.0, 9.0, size=E)
+    K_ref = _assert_kernel_matches_numpy(op, u, lengths)
+    # the averaging changes the answer (the test would not see a kernel ignoring it)
+    plain = replace(op, membrane_average=False)
+    assert _rel(kernels.layer_response(plain, u, lengths, 60.0)[1], K_ref) > 1e-3
+
+
+def test_averaged_membrane_kernel_on_a_core_rule():
+    """A 7×7 rule and the core's coupled C (C_xz ≠ 0) through the same kernel."""
+    rng = np.random.default_rng(23)
+    op = build_layer_operators("core", 25.0, 0.0, core_stiffness(ROHACELL),
+                               gauss=EXACT_ORDER["core"], membrane_average=True)
+    u = rng.normal(size=(40, 40)) * 0.5
+    lengths = rng.uniform(1.0, 9.0, size=40)
     f_ref, K_ref = element.layer_response(op, u, lengths, 60.0)
     f, K = kernels.layer_response(op, u, lengths, 60.0)
     assert _rel(f, f_ref) < 1e-13
     assert _rel(K, K_ref) < 1e-13
-    assert np.array_equal(K, K.transpose(0, 2, 1))  # symmetric by construction
-    f_only, none = kernels.layer_response(op, u, lengths, 60.0, tangent=False)
-    assert none is None and np.array_equal(f_only, f)
+
+
+def test_averaged_membrane_falls_back_to_numpy_where_the_kernel_cannot():
+    rng = np.random.default_rng(29)
+    C = _full_symmetric_stiffness(rng)
+    C[0, 2] += 1.0  # not symmetric: the rank-2 update of averaged_kernel does not hold
+    op = build_layer_operators("top", 0.5, 0.0, C, gauss=EXACT_ORDER["top"],
+                               membrane_average=True)
+    assert not kernels.supports(op)
+    with pytest.raises(ValueError, match="not evaluated by the kernels"):
+        kernels.layer_response(op, np.zeros((2, 40)), np.ones(2), 60.0)
 
 
 def _enlarged(op, rng, extra=7, points=61):
@@ -103,6 +165,25 @@ def test_kernel_tangent_matches_finite_differences(name, h, C):
         fm = kernels.layer_response(op, u - du, lengths, 60.0, tangent=False)[0]
         fd = (fp - fm) / (2 * step)
         assert np.max(np.abs(K[:, :, a] - fd)) < 1e-6 * np.max(np.abs(K))
+
+
+@pytest.mark.parametrize("stretch", [False, True])
+def test_averaged_model_tangent_matches_finite_differences(stretch):
+    """Assembled reduced tangent (kernels, averaged faces, contact active) vs central FD."""
+    scene = sandwich_scene(length=60.0, elements=8, debonds=(Debond("top", 15.0, 45.0),))
+    model = build_model(scene, face_membrane="averaged", face_stretch=stretch)
+    assert all(kernels.supports(model.layers[n]) and model.layers[n].membrane_average
+               for n in ("top", "bottom"))
+    u = _contact_state(model, np.random.default_rng(31))
+    K = model.tangent(u).toarray()
+    step = 1e-6
+    worst = 0.0
+    for j in range(model.size):
+        du = np.zeros(model.size)
+        du[j] = step
+        fd = (model.internal_force(u + du) - model.internal_force(u - du)) / (2 * step)
+        worst = max(worst, np.max(np.abs(K[:, j] - fd)))
+    assert worst < 1e-6 * np.max(np.abs(K))
 
 
 def _contact_state(model, rng):
