@@ -16,8 +16,6 @@ import itertools
 import json
 import math
 import re
-import stat
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,6 +23,7 @@ from typing import Any
 from models import get_model
 from sandwich.scene import NAME_PATTERN, Problem, Scene, SceneError, is_finite_number
 from sandwich.scene_checks import build_scene
+from sandwich.scene_file import read_toml_file
 from studies.study_params import DERIVED, DERIVED_KEYS, PathError, base_value, resolve, set_path
 
 MODELS = ("beam", "2d")
@@ -111,29 +110,7 @@ def case_key(scene: Scene, model: str, options: dict[str, Any]) -> str:
 
 
 def _read_toml(path: Path, what: str) -> dict[str, Any]:
-    fname = str(path)
-    if "\0" in fname:  # the system cannot take it (Python raises ValueError)
-        raise StudyError([Problem(fname.replace("\0", "\\0"), "-",
-                                  "cannot be read (a NUL character in the file name)")])
-    try:
-        mode = path.stat().st_mode
-    except OSError as exc:
-        reason = "no such file" if isinstance(exc, FileNotFoundError) else (
-            f"cannot be read ({exc.strerror or exc})")
-        raise StudyError([Problem(fname, "-", reason)]) from None
-    if not stat.S_ISREG(mode):
-        raise StudyError([Problem(fname, "-", "not a regular file")])
-    try:
-        return tomllib.loads(path.read_bytes().decode("utf-8-sig"))
-    except OSError as exc:
-        raise StudyError([Problem(fname, "-", f"cannot be read ({exc.strerror or exc})")]
-                         ) from None
-    except UnicodeDecodeError as exc:
-        raise StudyError([Problem(fname, "-", f"not UTF-8 text ({exc.reason})")]) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError([Problem(fname, "-", f"not valid TOML: {exc}")]) from None
-    except RecursionError:
-        raise StudyError([Problem(fname, "-", f"nested too deeply to be a {what}")]) from None
+    return read_toml_file(path, what, StudyError)
 
 
 class _Problems:
