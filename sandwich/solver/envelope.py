@@ -23,6 +23,14 @@ inertia when even that fails). LAPACK has no banded LDLᵀ with pivoting for ind
 (banded LU with row interchanges) gives only the sign of det K, not the count of negative
 eigenvalues (docs/beam_speed.md).
 
+The envelope storage is fixed by the pattern, but its rows are factorised from where their
+*values* start (:func:`_numerical_first`, one scan per factorisation): a pattern holds
+couplings that are zero in most states — a closest-point contact pair couples its face node to
+every searched core segment, its tangent lives on the chosen one only, and an open pair's is
+zero — and the factor has no fill before a row's first non-zero (the same L and D, fewer
+operations: fig. 5 at core level 1, 240 elements, 3.2 → 1.3 ms per factorisation,
+docs/beam_speed.md).
+
 The symbolic work — ordering (natural or reverse Cuthill-McKee, whichever has the smaller
 envelope), ``first``, the storage and the map from CSR slots to its positions — is an
 :class:`EnvelopeStructure`, computed once per sparsity pattern and reused for every matrix of
@@ -240,13 +248,42 @@ def _load(data, slots, positions, size):  # pragma: no cover - compiled
     return env, (kmax if finite else np.nan)
 
 
+@njit
+def _numerical_first(env, rowptr, first, n):  # pragma: no cover - compiled
+    """lo[i]: the column of row i's first non-zero value in the stored envelope (≥ first[i]).
+
+    The diagonal ends each stored row and is not scanned, so lo[i] ≤ i.
+    """
+    lo = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        p, end = rowptr[i], rowptr[i + 1] - 1
+        while p < end and env[p] == 0.0:
+            p += 1
+        lo[i] = first[i] + (p - rowptr[i])
+    return lo
+
+
+@njit
+def _numerical_flops(lo, n):  # pragma: no cover - compiled
+    """Operations of :func:`_ldlt` on the numerical envelope ``lo`` (as :func:`_count_flops`)."""
+    total = 0
+    for i in range(n):
+        fi = lo[i]
+        for j in range(fi, i):
+            k0 = fi if fi > lo[j] else lo[j]
+            total += 2 * (j - k0) + 3
+    return total
+
+
 @njit(reassociate=True)
-def _ldlt(env, rowptr, first, n, w):  # pragma: no cover - compiled
+def _ldlt(env, rowptr, first, lo, n, w):  # pragma: no cover - compiled
     """In-place envelope LDLᵀ (row-by-row Crout): L below the diagonal, D on it.
 
-    Row i: w_j = a_ij − Σ_k w_k L_jk (k from max(first_i, first_j) to j − 1) is (L D)_ij, then
-    L_ij = w_j / d_j and d_i = a_ii − Σ_j w_j L_ij. Returns (negative pivots, min |d|,
-    max |L D|, max |L|).
+    Row i: w_j = a_ij − Σ_k w_k L_jk (k from max(lo_i, lo_j) to j − 1) is (L D)_ij, then
+    L_ij = w_j / d_j and d_i = a_ii − Σ_j w_j L_ij. ``first`` places the rows in ``env``;
+    ``lo`` ≥ ``first`` (:func:`_numerical_first`) is where each row's values start: the
+    entries before it are zero in K and stay zero in L (w_ij = 0 for j < lo_i by induction on
+    j), so they are skipped. Returns (negative pivots, min |d|, max |L D|, max |L|).
     """
     negative = 0
     finite = True
@@ -254,11 +291,11 @@ def _ldlt(env, rowptr, first, n, w):  # pragma: no cover - compiled
     ldmax = 0.0
     lmax = 0.0
     for i in range(n):
-        fi = first[i]
-        ri = rowptr[i] - fi  # env[ri + j] is entry (i, j)
+        fi = lo[i]
+        ri = rowptr[i] - first[i]  # env[ri + j] is entry (i, j)
         for j in range(fi, i):
-            fj = first[j]
-            rj = rowptr[j] - fj
+            fj = lo[j]
+            rj = rowptr[j] - first[j]
             k0 = fi if fi > fj else fj
             s = env[ri + j]
             for k in range(k0, j):
@@ -360,13 +397,16 @@ def _column_solve(env, colptr, last, n, order, rhs, x):  # pragma: no cover - co
 
 
 @njit(reassociate=True)
-def _solve(env, rowptr, first, n, order, b, x):  # pragma: no cover - compiled
-    """Solve K x = b with K = Pᵀ L D Lᵀ P; b, x of shape (n, m), m right-hand sides."""
+def _solve(env, rowptr, first, lo, n, order, b, x):  # pragma: no cover - compiled
+    """Solve K x = b with K = Pᵀ L D Lᵀ P; b, x of shape (n, m), m right-hand sides.
+
+    Row i of L is stored from ``first[i]``, non-zero from ``lo[i]`` on (as in :func:`_ldlt`).
+    """
     y = np.empty(n)
     for c in range(b.shape[1]):
         for i in range(n):  # forward: L y = P b
-            fi = first[i]
-            ri = rowptr[i] - fi
+            fi = lo[i]
+            ri = rowptr[i] - first[i]
             s = b[order[i], c]
             for k in range(fi, i):
                 s -= env[ri + k] * y[k]
@@ -374,8 +414,8 @@ def _solve(env, rowptr, first, n, order, b, x):  # pragma: no cover - compiled
         for i in range(n):  # D z = y
             y[i] /= env[rowptr[i + 1] - 1]
         for i in range(n - 1, -1, -1):  # backward: Lᵀ x = z, column by column
-            fi = first[i]
-            ri = rowptr[i] - fi
+            fi = lo[i]
+            ri = rowptr[i] - first[i]
             xi = y[i]
             for k in range(fi, i):
                 y[k] -= env[ri + k] * xi
@@ -396,11 +436,20 @@ class EnvelopeFactorization:
 
     pivoted = False
 
-    def __init__(self, env: np.ndarray, structure: EnvelopeStructure, negative: int) -> None:
+    def __init__(self, env: np.ndarray, structure: EnvelopeStructure, negative: int,
+                 lo: np.ndarray | None = None) -> None:
         self._env = env
         self.structure = structure
         self.size = structure.n
         self._negative = negative
+        self._lo = structure.first if lo is None else lo  # "envelope": where rows are non-zero
+
+    @property
+    def flops(self) -> float:
+        """Operations this factorisation did: the numerical envelope's for ``"envelope"``."""
+        if self.structure.storage == "columns":
+            return self.structure.flops
+        return float(_numerical_flops(self._lo, self.size))
 
     @property
     def negative_pivots(self) -> int:
@@ -418,7 +467,7 @@ class EnvelopeFactorization:
         if s.storage == "columns":
             _column_solve(self._env, s.colptr, s.last, s.n, s.order, B, x)
         else:
-            _solve(self._env, s.rowptr, s.first, s.n, s.order, B, x)
+            _solve(self._env, s.rowptr, s.first, self._lo, s.n, s.order, B, x)
         return x.reshape(b.shape)
 
 
@@ -460,13 +509,15 @@ def factorize_envelope(
         raise SingularTangentError("tangent has non-finite entries")
     if kmax == 0.0:
         raise SingularTangentError("tangent is the zero matrix")
+    lo = None
     if structure.storage == "columns":
         negative, dmin, ldmax, lmax = _column_ldlt(env, structure.colptr, structure.last, n)
     else:
-        negative, dmin, ldmax, lmax = _ldlt(env, structure.rowptr, structure.first, n,
+        lo = _numerical_first(env, structure.rowptr, structure.first, n)
+        negative, dmin, ldmax, lmax = _ldlt(env, structure.rowptr, structure.first, lo, n,
                                             np.empty(n))
     growth = max(ldmax / kmax, lmax)
     if (not np.isfinite(dmin) or dmin <= singular_rtol * n * kmax
             or not np.isfinite(growth) or growth > GROWTH_LIMIT):
         return SparseFactorization(A, singular_rtol)
-    return EnvelopeFactorization(env, structure, int(negative))
+    return EnvelopeFactorization(env, structure, int(negative), lo)

@@ -51,6 +51,44 @@ def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeyp
     assert np.allclose(fac.solve(b[:, 0]), x[:, 0], rtol=0, atol=1e-14 * np.abs(x).max())
 
 
+def test_explicit_zeros_in_wide_rows_are_skipped_with_the_same_answer(monkeypatch):
+    """A pattern wider than its values (a contact pair's unchosen segments): same inertia and
+    solution as the dense matrix, at the numerical envelope's operation count."""
+    from sandwich.solver import envelope
+
+    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 0.0)  # the row envelope
+    rng = np.random.default_rng(7)
+    n = 60
+    A = _variable_band(rng, n, np.full(n, 3))
+    wide = [20, 21, 40, 41]  # rows that couple 15 columns back in the pattern only
+    rows = [i for i in wide for _ in range(12)]
+    cols = [j for i in wide for j in range(i - 15, i - 3)]
+    Z = sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    B = (A + Z + Z.T).tocsr()
+    B.sort_indices()
+    r = np.repeat(np.arange(n), np.diff(B.indptr))
+    B.data[:] = A.toarray()[r, B.indices]  # the pattern of B, the values of A
+    assert B.nnz > A.nnz and abs(B - A).max() == 0.0
+    s = EnvelopeStructure.of(B)
+    fac = factorize_envelope(B, s)
+    eig = np.linalg.eigvalsh(A.toarray())
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+    assert fac.flops < 0.7 * s.flops  # the explicit zeros are not worked on
+    b = rng.normal(size=n)
+    cond = np.abs(eig).max() / np.abs(eig).min()
+    assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
+    # the same structure with the wide couplings non-zero: all of it is worked on again
+    C = B.copy()
+    C.data = C.data + 0.1 * (Z + Z.T).toarray()[r, C.indices]
+    assert s.matches(C)
+    full = factorize_envelope(C, s)
+    assert full.flops > fac.flops
+    eig_c = np.linalg.eigvalsh(C.toarray())
+    assert full.negative_pivots == int(np.count_nonzero(eig_c < 0))
+    assert np.linalg.norm(C @ full.solve(b) - b) <= 1e-12 * np.abs(eig_c).max() / np.abs(
+        eig_c).min() * np.linalg.norm(b)
+
+
 def test_rcm_ordering_recovers_a_scrambled_band():
     rng = np.random.default_rng(1)
     n = 200
