@@ -406,7 +406,37 @@ def _projection_residual(ξ, l, xa, U, W, xs, ws):
     return r1 * a + r2 * c, -(a**2 + c**2) + r1 * aξ + r2 * cξ, a, c
 
 
+_KERNEL: list = []
+
+
+def _closest_point_kernel():
+    """The compiled kernel (:mod:`beam_element.contact_kernel`), or None without numba."""
+    if not _KERNEL:
+        try:
+            from beam_element.contact_kernel import closest_point_kernel
+        except ImportError:
+            closest_point_kernel = None
+        _KERNEL.append(closest_point_kernel)
+    return _KERNEL[0]
+
+
 def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
+    """Closest-point kinematics of every pair: compiled where numba is, else NumPy."""
+    kernel = _closest_point_kernel()
+    if kernel is None or pairs.size == 0:
+        return _compact_kinematics_numpy(pairs, u_full)
+    xa, l, U, W, xs, ws = _segment_geometry(pairs, u_full)
+    out = kernel(np.ascontiguousarray(xa), np.ascontiguousarray(l), np.ascontiguousarray(U),
+                 np.ascontiguousarray(W), np.ascontiguousarray(xs[:, 0]),
+                 np.ascontiguousarray(ws[:, 0]), np.ascontiguousarray(pairs.x[pairs.nodes]),
+                 np.ascontiguousarray(pairs.segment_valid), NORMAL_SIGN[pairs.interface],
+                 PROJECTION_TOL, PROJECTION_MAX_ITERATIONS, PROJECTION_RESIDUAL_TOL,
+                 IN_SEGMENT_TOL)
+    return _Compact(*out)
+
+
+def _compact_kinematics_numpy(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
+    """The NumPy reference of :func:`_compact_kinematics` (the module docstring's equations)."""
     m = pairs.size
     xa, l, U, W, xs, ws = _segment_geometry(pairs, u_full)
     x_node = pairs.x[pairs.nodes][:, None]

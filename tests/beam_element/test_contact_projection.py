@@ -395,3 +395,32 @@ def test_consistent_tangent_beyond_the_searched_segments(interface):
         assert np.allclose(KK[:, j], fd, rtol=0, atol=1e-6 * np.abs(KK).max())
         W = pairs.area[0] * (contact_energy(kp.gap[0], EPS, S) - contact_energy(km.gap[0], EPS, S))
         assert W / (2 * h) == pytest.approx(F[j], abs=1e-6 * np.abs(F).max())
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_compiled_kinematics_match_the_numpy_reference(interface):
+    """beam_element.contact_kernel against contact._compact_kinematics_numpy (the equations
+    written array-wise): rotated wavy core, slidings inside and beyond the reach, open and
+    closed pairs; the same segment, ξ and outside flags, gap and derivatives to round-off."""
+    from beam_element import contact
+
+    if contact._closest_point_kernel() is None:
+        pytest.skip("numba not installed: the NumPy path is the only one")
+    rng = np.random.default_rng(11)
+    nodes = np.arange(1, XU.size - 1)
+    pairs = contact_pairs(interface, nodes, XU, 60.0, search="closest-point", reach=1.0)
+    for trial in range(4):
+        slide = rng.uniform(-1.5, 1.5, nodes.size) * (0.3 + trial / 3)
+        gaps = rng.uniform(-0.05, 0.05, nodes.size)
+        u = _state(interface, slide, gaps, theta=0.1 * trial, x=XU, nodes=nodes)
+        a = contact._compact_kinematics(pairs, u)
+        b = contact._compact_kinematics_numpy(pairs, u)
+        assert b.outside.any() or trial < 2
+        np.testing.assert_array_equal(a.segment, b.segment)
+        np.testing.assert_array_equal(a.outside, b.outside)
+        np.testing.assert_array_equal(a.cols, b.cols)
+        np.testing.assert_allclose(a.xi, b.xi, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a.gap, b.gap, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a.sliding, b.sliding, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a.grad, b.grad, rtol=0, atol=1e-10 * np.abs(b.grad).max())
+        np.testing.assert_allclose(a.hess, b.hess, rtol=0, atol=1e-9 * np.abs(b.hess).max())
