@@ -21,7 +21,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from comparisons.agreement import markdown, scene_row  # noqa: E402
+from comparisons.agreement import fine_check, markdown, scene_row  # noqa: E402
 
 # Where the 2D model is (not) a trustworthy reference, per scene, and why. Sources: README "How
 # far to trust it" (Green-strain core crushing under concentrated loads), docs/comparisons.md
@@ -63,12 +63,25 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", type=Path,
                    default=ROOT / "benchmarks/results/comparisons/gallery_agreement")
     p.add_argument("--header", default="", help="run conditions (commit, date, load, times)")
+    p.add_argument("--fine", action="append", default=[], metavar="SCENE=DIR",
+                   help="a finer 2D run of SCENE (its result folder) to check both models "
+                        "against (repeatable)")
     a = p.parse_args(argv)
+    fine = {}
+    for item in a.fine:
+        name, sep, folder = item.partition("=")
+        if not sep or not (Path(folder) / "summary.json").is_file():
+            print(f"--fine {item}: expected SCENE=DIR with DIR/summary.json", file=sys.stderr)
+            return 2
+        fine[name] = Path(folder)
     folders = sorted(f for f in a.gallery.iterdir() if (f / "metrics.json").is_file())
     if not folders:
         print(f"{a.gallery}: no <scene>/metrics.json", file=sys.stderr)
         return 2
     rows = [scene_row(f, TRUST) for f in folders]
+    for r in rows:
+        if r["scene"] in fine:
+            fine_check(r, fine[r["scene"]])
     a.out.with_suffix(".md").write_text(markdown(rows, str(a.gallery), a.header))
     keys = list(dict.fromkeys(k for r in rows for k in r))
     with a.out.with_suffix(".csv").open("w", newline="") as fh:

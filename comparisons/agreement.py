@@ -8,7 +8,9 @@ of the path, ``w_end`` = the largest |until probe| both monotone paths reach,
 λ_beam(w_end)/λ_2D(w_end) − 1 (linear interpolation in each history); the load-curve L2 and max
 relative errors of ``metrics.json`` (their common range is the same); the beam's core levels
 (length of x at each level) and its own error estimate; the models' messages when they did not
-converge or warned. Pure data handling, like :mod:`comparisons.paths`.
+converge or warned. :func:`fine_check` adds, where a finer 2D run of the scene is at hand,
+both models' end loads against it (so that a 2D mesh's own error is told apart from the
+beam's). Pure data handling, like :mod:`comparisons.paths`.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from comparisons.paths import LOAD, path_curve
-from sandwich.results import load_result
+from sandwich.results import Solution, load_result
 
 
 def _load_at(curve_x: np.ndarray, curve_y: np.ndarray, w: float) -> float | None:
@@ -124,6 +126,17 @@ def markdown(rows: list[dict[str, object]], source: str, header: str) -> str:
             f"{r['beam_steps']} / {_g(r['beam_wall_s'], '.3g')} | "
             f"{_g(r.get('2d_reach'), '.3g')} / {r['2d_steps']} / {_g(r['2d_wall_s'], '.3g')} | "
             f"{r.get('beam_levels', '')} ({_pct(est)}) |")
+    checked = [r for r in rows if "2d_fine_load_at_w_end" in r]
+    if checked:
+        lines += ["", "## Against a finer 2D mesh", "",
+                  "Both models' loads at the same w_end against a finer 2D run of the scene "
+                  "(its level named): the gallery's 2D mesh error next to the beam's.", "",
+                  "| scene | 2D finer level | λ 2D finer | beam vs finer | gallery 2D vs finer |",
+                  "|---|---|---|---|---|"]
+        lines += [f"| {r['scene'].removeprefix('paper-')} | {r.get('2d_fine_level') or '—'} | "
+                  f"{_g(r.get('2d_fine_load_at_w_end'))} | "
+                  f"{_pct(r.get('end_load_rel_fine'), True)} | "
+                  f"{_pct(r.get('2d_rel_fine'), True)} |" for r in checked]
     lines += ["", "## Is the 2D model a trustworthy reference here?", "",
               "| scene | 2D trustworthy? |", "|---|---|"]
     lines += [f"| {r['scene'].removeprefix('paper-')} | {r['trust_2d']} |" for r in rows]
@@ -134,3 +147,23 @@ def markdown(rows: list[dict[str, object]], source: str, header: str) -> str:
                 text = " ".join(str(r[f"{m}_message"]).split())
                 lines.append(f"- {r['scene'].removeprefix('paper-')}, {m}: {text}")
     return "\n".join(lines) + "\n"
+
+
+def fine_check(row: dict[str, object], fine: Solution | Path) -> dict[str, object]:
+    """Add to ``row`` the end loads of both models against a finer 2D run at ``w_end``.
+
+    ``fine`` is the finer run (a :class:`~sandwich.results.Solution` or its result folder);
+    it is read on the row's abscissa. New keys: ``2d_fine_level``, ``2d_fine_load_at_w_end``,
+    ``end_load_rel_fine`` (beam vs fine) and ``2d_rel_fine`` (the gallery's 2D vs fine); None
+    where the finer path stops short of ``w_end``.
+    """
+    sol = fine if isinstance(fine, Solution) else load_result(Path(fine), fields=False)
+    curve, _ = path_curve(sol, str(row["abscissa"]), LOAD)
+    w_end = row.get("w_end")
+    lam = _load_at(curve.x, curve.y, float(w_end)) if w_end is not None else None
+    row["2d_fine_level"] = sol.extra.get("level")
+    row["2d_fine_load_at_w_end"] = lam
+    for key, model in (("end_load_rel_fine", "beam"), ("2d_rel_fine", "2d")):
+        v = row.get(f"{model}_load_at_w_end")
+        row[key] = v / lam - 1.0 if v is not None and lam else None
+    return row

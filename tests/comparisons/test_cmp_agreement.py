@@ -61,3 +61,21 @@ def test_an_early_stop_moves_the_common_end_and_is_reported(tmp_path, scene, syn
     assert row["beam_first_max"] is None and row["first_max_rel"] is None
     assert row["trust_2d"] == "not assessed"
     assert "no convergence (synthetic)" in markdown([row], "DIR", "")
+
+
+def test_fine_check_tells_the_2d_mesh_error_from_the_beams(tmp_path, scene, synth):
+    """A "finer" 2D run 2 % below the gallery's 2D: the gallery 2D reads +2 % on it and the
+    beam (1 + EPS)/(1 − 0.02) − 1; a finer path that stops short gives None, not a number."""
+    from comparisons.agreement import fine_check
+
+    folder = _gallery_scene(tmp_path, scene, synth.fake_solvers(EPS))
+    finer = synth.make_solution("2d", eps=-0.02, n_steps=300, scene=scene.name)
+    row = fine_check(scene_row(folder), finer)
+    assert row["2d_fine_level"] == "medium"  # the synthetic runs' recorded level
+    assert row["2d_rel_fine"] == pytest.approx(1 / 0.98 - 1, abs=1e-9)
+    assert row["end_load_rel_fine"] == pytest.approx(1.03 / 0.98 - 1, abs=1e-9)
+    assert "Against a finer 2D mesh" in markdown([row], "DIR", "")
+    short = dataclasses.replace(finer, history=finer.history[:100])
+    row = fine_check(scene_row(folder), short)
+    assert row["2d_fine_load_at_w_end"] is None and row["end_load_rel_fine"] is None
+    assert "nan" not in markdown([row], "DIR", "").lower()
