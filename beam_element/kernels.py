@@ -52,9 +52,9 @@ from beam_element.layer_operators import LayerOperators
 from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
 from sandwich.solver.jit import njit
 
-__all__ = ["KernelOperators", "csr_slots", "embed_pattern", "kernel_operators", "layer_assemble",
-           "layer_blocks", "layer_flops", "layer_response", "point_flops", "scatter_blocks",
-           "supports", "uses_sum_factorisation"]
+__all__ = ["KernelOperators", "block_pattern", "block_slots", "embed_pattern", "kernel_operators",
+           "layer_assemble", "layer_blocks", "layer_flops", "layer_response", "point_flops",
+           "scatter_blocks", "supports", "uses_sum_factorisation"]
 
 
 @dataclass(frozen=True)
@@ -235,21 +235,63 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
 
 
 @njit
-def csr_slots(indptr, indices, rows, cols):  # pragma: no cover - compiled
-    """Slot of each entry (rows[t], cols[t]) in a canonical CSR pattern (binary search)."""
-    out = np.empty(rows.size, dtype=np.int64)
-    for t in range(rows.size):
-        lo = indptr[rows[t]]
-        hi = indptr[rows[t] + 1]
-        c = cols[t]
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if indices[mid] < c:
-                lo = mid + 1
-            else:
-                hi = mid
-        out[t] = lo
-    return out
+def block_pattern(bptr, bdofs, inc_ptr, inc_block, n):  # pragma: no cover - compiled
+    """Canonical CSR pattern (indptr, indices) of the union of dense blocks.
+
+    Block g covers the reduced DOFs ``bdofs[bptr[g]:bptr[g + 1]]`` (−1: eliminated); row r
+    lies in the blocks ``inc_block[inc_ptr[r]:inc_ptr[r + 1]]``. Row r's columns are the
+    union of those blocks' DOFs, sorted.
+    """
+    mark = np.full(n, -1, dtype=np.int64)
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    for r in range(n):  # count
+        c = 0
+        for t in range(inc_ptr[r], inc_ptr[r + 1]):
+            g = inc_block[t]
+            for q in range(bptr[g], bptr[g + 1]):
+                j = bdofs[q]
+                if j >= 0 and mark[j] != r:
+                    mark[j] = r
+                    c += 1
+        indptr[r + 1] = indptr[r] + c
+    indices = np.empty(indptr[n], dtype=np.int64)
+    mark[:] = -1
+    for r in range(n):  # fill and sort
+        p = indptr[r]
+        for t in range(inc_ptr[r], inc_ptr[r + 1]):
+            g = inc_block[t]
+            for q in range(bptr[g], bptr[g + 1]):
+                j = bdofs[q]
+                if j >= 0 and mark[j] != r:
+                    mark[j] = r
+                    indices[p] = j
+                    p += 1
+        indices[indptr[r]:indptr[r + 1]] = np.sort(indices[indptr[r]:indptr[r + 1]])
+    return indptr, indices
+
+
+@njit
+def block_slots(free, indptr, indices, n, out):  # pragma: no cover - compiled
+    """CSR slot of every entry of dense blocks (B, m) of reduced DOFs ``free`` (−1: none).
+
+    ``out`` (B, m, m) receives the slot of entry (free[b, i], free[b, j]), −1 where either
+    DOF is eliminated.
+    """
+    pos = np.full(n, -1, dtype=np.int64)
+    B, m = free.shape
+    for b in range(B):
+        for i in range(m):
+            r = free[b, i]
+            if r < 0:
+                out[b, i, :] = -1
+                continue
+            for p in range(indptr[r], indptr[r + 1]):
+                pos[indices[p]] = p
+            for j in range(m):
+                c = free[b, j]
+                out[b, i, j] = pos[c] if c >= 0 else -1
+            for p in range(indptr[r], indptr[r + 1]):
+                pos[indices[p]] = -1
 
 
 @njit

@@ -308,15 +308,32 @@ def test_a_matrix_inside_the_model_pattern_reuses_its_factorisation_structure():
 
 
 @pytest.mark.parametrize("options", [{}, {"core_level": 2}, {"contact_search": "closest-point"}])
-def test_reduced_pattern_is_the_same_with_and_without_the_compiled_search(options, monkeypatch):
+def test_reduced_pattern_is_the_same_with_and_without_the_compiled_builder(options, monkeypatch):
+    """The compiled pattern builder against the sort of every local entry's key (np.unique),
+    and both against the scipy COO → CSR pattern of Tᵀ K T's entries."""
     from beam_element import assembly
 
     scene = sandwich_scene(length=60.0, elements=12,
                            debonds=(Debond("top", 15.0, 45.0), Debond("bottom", 0.0, 20.0)))
     model = build_model(scene, **options)
     fast = assembly.reduced_pattern(model.block_dofs, model.dof_map)
-    monkeypatch.setattr(assembly, "_SLOT_SEARCH", [None])  # the np.unique path
+    monkeypatch.setattr(assembly, "_PATTERN_KERNELS", [None])  # the np.unique path
     slow = assembly.reduced_pattern(model.block_dofs, model.dof_map)
     for key in ("slot", "keep", "weight", "indices", "indptr"):
         a, b = getattr(fast, key), getattr(slow, key)
         assert a.dtype == b.dtype and np.array_equal(a, b), key
+    for (sa, wa), (sb, wb) in zip(fast.family_slots, slow.family_slots, strict=True):
+        assert sa.dtype == np.int32 and wa.dtype == np.int8
+        assert np.array_equal(sa, sb) and np.array_equal(wa, wb)
+    rows = np.concatenate([np.repeat(d, d.shape[1], axis=1).reshape(-1)
+                           for d in model.block_dofs])
+    cols = np.concatenate([np.tile(d, (1, d.shape[1])).reshape(-1) for d in model.block_dofs])
+    r, c = model.dof_map.free[rows], model.dof_map.free[cols]
+    ok = (r >= 0) & (c >= 0)
+    P = sp.csr_matrix((np.ones(ok.sum()), (r[ok], c[ok])), shape=(fast.n, fast.n))
+    P.sum_duplicates()
+    assert np.array_equal(P.indptr, fast.indptr) and np.array_equal(P.indices, fast.indices)
+    # every kept entry's slot holds its (row, column)
+    slot_row = np.repeat(np.arange(fast.n), np.diff(fast.indptr))
+    assert np.array_equal(slot_row[fast.slot], r[ok]) and np.array_equal(
+        fast.indices[fast.slot], c[ok])
