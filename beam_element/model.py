@@ -215,7 +215,8 @@ class BeamModel:
     def factorize(self, K: sp.spmatrix) -> object:
         """Envelope LDLᵀ of the tangent with its inertia (:mod:`sandwich.solver.envelope`).
 
-        The symbolic part (ordering, envelope) is computed once per sparsity pattern and kept;
+        The symbolic part (ordering, envelope of the values) is computed once per sparsity
+        pattern and kept, widened when a tangent has a coupling outside it;
         SuperLU (:class:`sandwich.solver.sparse.SparseFactorization`) is the fallback when the
         pivot-free LDLᵀ is untrustworthy, or when numba is not installed.
         """
@@ -236,10 +237,16 @@ class BeamModel:
                 K = embedded
                 structure = next((s for s in known if s.matches(K)), None)
         if structure is None:
-            structure = EnvelopeStructure.of(K)
+            # the envelope of the values: the pattern's contact couplings to unchosen segments
+            # and open pairs are zero; a matrix with a coupling outside it widens it
+            structure = EnvelopeStructure.of(K, numeric=True)
             known.insert(1 if known else 0, structure)  # keep the model's own pattern's
             del known[4:]
-        return factorize_envelope(K, structure)
+        fac = factorize_envelope(K, structure)
+        widened = getattr(fac, "structure", structure)
+        if widened is not structure and widened.matches(K):
+            known[known.index(structure)] = widened
+        return fac
 
     def _on_pattern(self, K: sp.csr_matrix) -> sp.csr_matrix | None:
         """``K`` with the model's reduced sparsity pattern, if its non-zeros lie inside it."""

@@ -31,6 +31,14 @@ zero — and the factor has no fill before a row's first non-zero (the same L an
 operations: fig. 5 at core level 1, 240 elements, 3.2 → 1.3 ms per factorisation,
 docs/beam_speed.md).
 
+A structure can also be built on the envelope of the values of the first matrix it serves
+(``EnvelopeStructure.of(K, numeric=True)``, what the beam model asks for): narrower still, and
+with column storage affordable again (fig. 5, 240 elements: level 1 1.3 → 0.9 ms, level 3
+19.6 → 11.1 ms per factorisation). Pattern entries outside it must be zero; a matrix with a
+non-zero there makes :func:`factorize_envelope` widen the structure (the union, same ordering)
+and hand the widened one back with the factorisation (fig. 5 path at level 2: 13 widenings in
+138 iterations, as contact pairs close and projections move to new segments).
+
 The symbolic work — ordering (natural or reverse Cuthill-McKee, whichever has the smaller
 envelope), ``first``, the storage and the map from CSR slots to its positions — is an
 :class:`EnvelopeStructure`, computed once per sparsity pattern and reused for every matrix of
@@ -129,24 +137,43 @@ class EnvelopeStructure:
                 and (K.indptr is self.indptr or np.array_equal(K.indptr, self.indptr)))
 
     @classmethod
-    def of(cls, K: sp.spmatrix) -> EnvelopeStructure:
-        """Structure for the pattern of ``K`` (CSR, canonical: sorted, no duplicates)."""
+    def of(cls, K: sp.spmatrix, *, numeric: bool = False,
+           widen: EnvelopeStructure | None = None) -> EnvelopeStructure:
+        """Structure for the pattern of ``K`` (CSR, canonical: sorted, no duplicates).
+
+        ``numeric``: the envelope of K's non-zero *values* (its explicit zeros left out; the
+        diagonal always in), still mapped from K's whole CSR pattern: a pattern entry outside
+        it must be zero when a matrix is loaded, else :func:`factorize_envelope` widens the
+        structure (``widen``: the union with that structure's envelope, in its ordering).
+        """
         from scipy.sparse.csgraph import reverse_cuthill_mckee
 
         K = _canonical_csr(K)
         n = K.shape[0]
         indptr, indices = K.indptr, K.indices
-        T = K.tocsc()  # the transpose's CSR pattern
+        P = K
+        if numeric:  # the non-zero values' pattern, with the diagonal
+            P = K.copy()
+            P.data = np.where(P.data != 0.0, 1.0, 0.0)
+            P.eliminate_zeros()
+            P = (P + sp.eye(n, format="csr")).tocsr()
+            P.sort_indices()
+        T = P.tocsc()  # the transpose's CSR pattern
         t_indptr, t_indices = T.indptr, T.indices
         candidates = {"natural": np.arange(n)}
-        if n > 1:
+        if widen is not None:
+            candidates = {widen.ordering: widen.order}
+        elif n > 1:
             candidates["rcm"] = np.asarray(
-                reverse_cuthill_mckee(sp.csr_matrix((np.ones(indices.size), indices, indptr),
-                                                    shape=K.shape), symmetric_mode=True),
+                reverse_cuthill_mckee(sp.csr_matrix((np.ones(P.indices.size), P.indices,
+                                                     P.indptr), shape=K.shape),
+                                      symmetric_mode=True),
                 dtype=np.int64)
         best = None
         for name, order in candidates.items():
-            first = _envelope_first(indptr, indices, order, t_indptr, t_indices)
+            first = _envelope_first(P.indptr, P.indices, order, t_indptr, t_indices)
+            if widen is not None:
+                first = np.minimum(first, widen.first)
             p = np.arange(n) - first
             cost = float(np.sum(p * p))
             if best is None or cost < 0.9 * best[0]:  # natural unless RCM is clearly better
@@ -168,13 +195,15 @@ class EnvelopeStructure:
         colptr[1:] = np.cumsum(last - np.arange(n) + 1)
         # Each storage is filled from the triangle whose CSR rows it stores contiguously (K is
         # symmetric): column j = K[j, j:last_j + 1] (upper), the envelope's row i
-        # = K[i, first_i:i + 1] (lower).
+        # = K[i, first_i:i + 1] (lower). Pattern entries outside a numeric envelope: −1.
         if columns:  # env[colptr[j] + (i − j)] = K[i, j] = K[j, i]
             kept = np.flatnonzero(j >= i)
-            positions = colptr[i[kept]] + (j[kept] - i[kept])
+            ik, jk = i[kept], j[kept]
+            positions = np.where(jk <= last[ik], colptr[ik] + (jk - ik), -1)
         else:
             kept = np.flatnonzero(j <= i)
-            positions = rowptr[i[kept]] + (j[kept] - first[i[kept]])
+            ik, jk = i[kept], j[kept]
+            positions = np.where(jk >= first[ik], rowptr[ik] + (jk - first[ik]), -1)
         return cls(n=n, order=order, first=first.astype(np.int64), rowptr=rowptr,
                    slots=kept.astype(np.int64), positions=positions.astype(np.int64),
                    indptr=indptr, indices=indices, ordering=name,
@@ -235,17 +264,22 @@ def _load(data, slots, positions, size):  # pragma: no cover - compiled
     """Storage filled from the stored triangle's CSR values, and their max |K|.
 
     NaN instead of the max if one value is not finite; K is symmetric, so this is max |K|.
+    Also whether a non-zero value fell outside the storage (a numeric structure's position −1).
     """
     env = np.zeros(size)
     kmax = 0.0
     finite = True
+    outside = False  # a non-zero where a numeric envelope has no place (position −1)
     for t in range(slots.size):
         v = data[slots[t]]
-        env[positions[t]] = v
+        if positions[t] >= 0:
+            env[positions[t]] = v
+        elif v != 0.0:
+            outside = True
         a = abs(v)
         finite &= a <= 1.0e308
         kmax = a if a > kmax else kmax
-    return env, (kmax if finite else np.nan)
+    return env, (kmax if finite else np.nan), outside
 
 
 @njit
@@ -504,7 +538,12 @@ def factorize_envelope(
     n = A.shape[0]
     if n == 0:
         return SparseFactorization(A)
-    env, kmax = _load(A.data, structure.slots, structure.positions, structure.size)
+    env, kmax, outside = _load(A.data, structure.slots, structure.positions, structure.size)
+    if outside:  # a numeric structure met a coupling its envelope lacks: widen it, once
+        structure = EnvelopeStructure.of(A, numeric=True, widen=structure)
+        env, kmax, outside = _load(A.data, structure.slots, structure.positions,
+                                   structure.size)
+        assert not outside
     if not np.isfinite(kmax):
         raise SingularTangentError("tangent has non-finite entries")
     if kmax == 0.0:

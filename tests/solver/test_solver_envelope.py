@@ -89,6 +89,48 @@ def test_explicit_zeros_in_wide_rows_are_skipped_with_the_same_answer(monkeypatc
         eig_c).min() * np.linalg.norm(b)
 
 
+def test_numeric_structure_widens_when_a_coupling_appears():
+    """A structure of the values (explicit zeros left out) is narrower than the pattern's; a
+    later matrix of the same pattern with those couplings non-zero is refused by it and
+    factorised on a widened structure (same ordering), with the dense answer both times."""
+    rng = np.random.default_rng(8)
+    n = 70
+    A = _variable_band(rng, n, np.full(n, 4))
+    wide = [30, 31, 50]
+    rows = [i for i in wide for _ in range(10)]
+    cols = [j for i in wide for j in range(i - 20, i - 10)]
+    Z = (sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n)))
+    Z = (Z + Z.T).tocsr()
+    pattern = (abs(A) + Z).tocsr()
+    pattern.sort_indices()
+    r = np.repeat(np.arange(n), np.diff(pattern.indptr))
+
+    def on_pattern(M):
+        out = pattern.copy()
+        out.data = M.toarray()[r, out.indices]
+        return out
+
+    B = on_pattern(A)  # the wide couplings stored as explicit zeros
+    s = EnvelopeStructure.of(B, numeric=True)
+    full = EnvelopeStructure.of(B)
+    assert s.matches(B) and s.ordering == full.ordering == "natural"
+    assert np.all(s.first >= full.first) and np.all(s.first[wide] > full.first[wide])
+    for M, widens in ((B, False), (on_pattern(A + 0.1 * Z), True)):
+        fac = factorize_envelope(M, s)
+        assert isinstance(fac, EnvelopeFactorization)
+        assert (fac.structure is not s) == widens
+        if widens:
+            assert fac.structure.matches(M) and np.array_equal(fac.structure.order, s.order)
+            assert np.all(fac.structure.first[wide] < s.first[wide])
+            again = factorize_envelope(M, fac.structure)
+            assert again.structure is fac.structure  # no second widening
+        eig = np.linalg.eigvalsh(M.toarray())
+        assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+        b = rng.normal(size=n)
+        cond = np.abs(eig).max() / np.abs(eig).min()
+        assert np.linalg.norm(M @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
+
+
 def test_rcm_ordering_recovers_a_scrambled_band():
     rng = np.random.default_rng(1)
     n = 200
