@@ -9,7 +9,7 @@ slot each local entry lands in and with which sign — is computed once; assembl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
@@ -20,14 +20,46 @@ from beam_element.constraints import DofMap
 
 @dataclass(frozen=True)
 class ReducedPattern:
-    """Where the entries of a list of dense local blocks go in the reduced CSR matrix."""
+    """Where the entries of a list of dense local blocks go in the reduced CSR matrix.
+
+    The slot map of a family (each local entry's CSR slot and sign) is built when first asked
+    for (:meth:`slots_of`): a family assembled another way (closest-point contact, on each
+    pair's chosen segment: :func:`beam_element.kernels.scatter_compact`) never builds its
+    (B, n, n) map, which on fine meshes is the largest array of the model.
+    """
 
     block_dofs: tuple[np.ndarray, ...]  # per block family: (B, n) full DOF indices
     indices: np.ndarray
     indptr: np.ndarray
     n: int
-    # per family: each local entry's CSR slot (−1 where eliminated) and sign product, (B, n, n)
-    family_slots: tuple[tuple[np.ndarray, np.ndarray], ...]
+    free: tuple[np.ndarray, ...]  # per family: (B, n) reduced DOF (−1: eliminated), int64
+    sign: tuple[np.ndarray, ...]  # per family: (B, n) sign of the reduced DOF (0: eliminated)
+    _slots: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def slots_of(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """Family ``i``'s ``(slots, signs)`` of shape ``(B, n, n)`` (−1 / 0 where eliminated).
+
+        For in-place assembly (:func:`beam_element.kernels.layer_assemble`); computed on first
+        use, then kept.
+        """
+        if i not in self._slots:
+            f = self.free[i]
+            B, m = f.shape
+            kernels = _pattern_kernels()
+            if kernels is None:
+                slots = _slots_sorted(f, self.indptr, self.indices)
+            else:
+                slots = np.empty((B, m, m), dtype=np.int64)
+                kernels[1](f, self.indptr.astype(np.int64), self.indices.astype(np.int64),
+                           self.n, slots)
+            sg = self.sign[i].astype(np.int8)
+            self._slots[i] = (slots.astype(np.int32), sg[:, :, None] * sg[:, None, :])
+        return self._slots[i]
+
+    @property
+    def family_slots(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        """Every family's :meth:`slots_of`."""
+        return tuple(self.slots_of(i) for i in range(len(self.block_dofs)))
 
     @cached_property
     def keep(self) -> np.ndarray:
@@ -53,28 +85,41 @@ class ReducedPattern:
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
 
 
-def _signs(block_dofs: list[np.ndarray], dof_map: DofMap) -> list[np.ndarray]:
-    """Per family, the sign product of each local entry (B, n, n), int8 (0 where eliminated)."""
-    out = []
-    for d in block_dofs:
-        s = np.where(dof_map.free[d] >= 0, dof_map.sign[d], 0).astype(np.int8)
-        out.append(s[:, :, None] * s[:, None, :])
-    return out
+def _slots_sorted(free: np.ndarray, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """:meth:`ReducedPattern.slots_of` without numba: one sorted search per kept entry."""
+    B, m = free.shape
+    n = indptr.size - 1
+    r = np.repeat(free[:, :, None], m, axis=2).reshape(-1)
+    c = np.repeat(free[:, None, :], m, axis=1).reshape(-1)
+    ok = (r >= 0) & (c >= 0)
+    out = np.full(r.size, -1, dtype=np.int64)
+    # the pattern's keys row * (n + 1) + column are sorted (rows in order, columns sorted)
+    row_key = np.repeat(np.arange(n, dtype=np.int64), np.diff(indptr)) * (n + 1) + indices
+    out[ok] = np.searchsorted(row_key, r[ok] * (n + 1) + c[ok])
+    return out.reshape(B, m, m)
 
 
 def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPattern:
     """Precompute the scatter of local blocks (full DOF index arrays ``(B, n)``) into Tᵀ K T.
 
-    Compiled (:func:`beam_element.kernels.block_pattern`, ``block_slots``: one pass over the
-    blocks of each row) where numba is, else by sorting every local entry's key.
+    Compiled (:func:`beam_element.kernels.block_pattern`: one pass over the blocks of each
+    row) where numba is, else by sorting every local entry's key; the slot maps per family on
+    demand (:meth:`ReducedPattern.slots_of`).
     """
     kernels = _pattern_kernels()
     n = dof_map.n_free
-    signs = _signs(block_dofs, dof_map)
-    if kernels is None:
-        return _reduced_pattern_sorted(block_dofs, dof_map, signs)
-    block_pattern, block_slots = kernels
     free = [np.ascontiguousarray(dof_map.free[d], dtype=np.int64) for d in block_dofs]
+    sign = [np.where(f >= 0, dof_map.sign[d], 0).astype(np.int8)
+            for f, d in zip(free, block_dofs, strict=True)]
+    if kernels is None:
+        indptr, indices = _pattern_sorted(free, n)
+    else:
+        indptr, indices = _pattern_compiled(free, n, kernels[0])
+    return ReducedPattern(block_dofs=tuple(block_dofs), indices=indices, indptr=indptr, n=n,
+                          free=tuple(free), sign=tuple(sign))
+
+
+def _pattern_compiled(free: list[np.ndarray], n: int, block_pattern) -> tuple:
     widths = np.concatenate([np.full(f.shape[0], f.shape[1], dtype=np.int64) for f in free])
     bptr = np.concatenate([[0], np.cumsum(widths)]).astype(np.int64)
     bdofs = np.concatenate([f.reshape(-1) for f in free])
@@ -88,41 +133,21 @@ def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPat
     rows, blocks = rows[first], blocks[first]
     inc_ptr = np.searchsorted(rows, np.arange(n + 1)).astype(np.int64)
     indptr, indices = block_pattern(bptr, bdofs, inc_ptr, blocks.astype(np.int64), n)
-    indptr, indices = indptr.astype(np.int32), indices.astype(np.int32)
-    slots = []
+    return indptr.astype(np.int32), indices.astype(np.int32)
+
+
+def _pattern_sorted(free: list[np.ndarray], n: int) -> tuple:
+    """The canonical CSR pattern of the blocks' entries by sorting their keys (no numba)."""
+    keys = []
     for f in free:
-        out = np.empty((f.shape[0], f.shape[1], f.shape[1]), dtype=np.int64)
-        block_slots(f, indptr, indices, n, out)
-        slots.append(out.astype(np.int32))
-    return ReducedPattern(block_dofs=tuple(block_dofs), indices=indices, indptr=indptr, n=n,
-                          family_slots=tuple(zip(slots, signs, strict=True)))
-
-
-def _reduced_pattern_sorted(
-    block_dofs: list[np.ndarray], dof_map: DofMap, signs: list[np.ndarray]
-) -> ReducedPattern:
-    """:func:`reduced_pattern` without numba: unique keys of every kept local entry."""
-    rows = np.concatenate([np.repeat(d[:, :, None], d.shape[1], axis=2).reshape(-1)
-                           for d in block_dofs])
-    cols = np.concatenate([np.repeat(d[:, None, :], d.shape[1], axis=1).reshape(-1)
-                           for d in block_dofs])
-    r, c = dof_map.free[rows], dof_map.free[cols]
-    keep = (r >= 0) & (c >= 0)
-    n = dof_map.n_free
-    keys = r[keep].astype(np.int64) * n + c[keep]
-    unique, slot = np.unique(keys, return_inverse=True)
-    row_of = unique // n
-    indptr = np.searchsorted(row_of, np.arange(n + 1)).astype(np.int32)
-    indices = (unique % n).astype(np.int32)
-    every = np.full(keep.size, -1, dtype=np.int64)
-    every[keep] = slot
-    out, offset = [], 0
-    for d, sg in zip(block_dofs, signs, strict=True):
-        B, m = d.shape
-        out.append((every[offset:offset + B * m * m].astype(np.int32).reshape(B, m, m), sg))
-        offset += B * m * m
-    return ReducedPattern(block_dofs=tuple(block_dofs), indices=indices, indptr=indptr, n=n,
-                          family_slots=tuple(out))
+        m = f.shape[1]
+        r = np.repeat(f[:, :, None], m, axis=2).reshape(-1)
+        c = np.repeat(f[:, None, :], m, axis=1).reshape(-1)
+        ok = (r >= 0) & (c >= 0)
+        keys.append(np.unique(r[ok] * n + c[ok]))
+    unique = np.unique(np.concatenate(keys))
+    indptr = np.searchsorted(unique // n, np.arange(n + 1)).astype(np.int32)
+    return indptr, (unique % n).astype(np.int32)
 
 
 _PATTERN_KERNELS: list = []

@@ -288,11 +288,7 @@ def pair_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
         cached = getattr(pairs, "_last", None)
         if cached is not None and np.array_equal(cached[0], v):
             return cached[1]
-        if pairs.parent is None:
-            k = _scatter(pairs, _compact_kinematics(pairs, u_full), pairs.core_nodes.shape[1])
-        else:  # one projection for all the interface's groups
-            k = _scatter(pairs, _cached_compact(pairs.parent, u_full),
-                         pairs.parent.core_nodes.shape[1], pairs.parent_rows)
+        k = _scatter(pairs, _own_compact(pairs, u_full))  # one projection for all groups
         object.__setattr__(pairs, "_last", (v, k))
         return k
     v = u_full[pairs.dofs]  # (m, 6)
@@ -374,26 +370,33 @@ def _cached_compact(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     return c
 
 
-def _scatter(
-    pairs: ContactPairs, c: _Compact, width: int, rows: np.ndarray | None = None
-) -> PairKinematics:
-    """Place compact kinematics (computed with ``width`` core nodes per pair) in the block."""
-    if rows is None:
-        rows = np.arange(pairs.size)
-    m = rows.size
-    shift = 4 * ((width - pairs.core_nodes.shape[1]) // 2)  # parent slot j ↔ own slot j − k_Δ
-    cols = c.cols[rows]
-    cols = np.where(cols >= 2, cols - shift, cols)
+def _own_compact(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
+    """Closest-point kinematics of ``pairs`` on their chosen segments, in their own layout.
+
+    A group of :func:`contact_pair_groups` reads its rows of the interface's one projection
+    (``parent``) and shifts the block columns to its own, narrower block.
+    """
+    if pairs.parent is None:
+        return _cached_compact(pairs, u_full)
+    c = _cached_compact(pairs.parent, u_full)
+    rows = pairs.parent_rows
+    shift = 4 * ((pairs.parent.core_nodes.shape[1] - pairs.core_nodes.shape[1]) // 2)
+    cols = c.cols[rows]  # parent slot j ↔ own slot j − k_Δ
+    return _Compact(c.gap[rows], c.grad[rows], c.hess[rows],
+                    np.where(cols >= 2, cols - shift, cols), c.sliding[rows], c.xi[rows],
+                    c.segment[rows] - shift // 4, c.outside[rows])
+
+
+def _scatter(pairs: ContactPairs, c: _Compact) -> PairKinematics:
+    """Place compact kinematics (own layout) in the pair's whole block."""
+    m = pairs.size
     n = pairs.support_dofs.shape[1]
     g_full = np.zeros((m, n))
     h_full = np.zeros((m, n, n))
     r = np.arange(m)
-    g_full[r[:, None], cols] = c.grad[rows]
-    h_full[r[:, None, None], cols[:, :, None], cols[:, None, :]] = c.hess[rows]
-    # segment index in this group's own layout
-    seg = c.segment[rows] - shift // 4
-    return PairKinematics(c.gap[rows], g_full, h_full, c.sliding[rows], c.xi[rows], seg,
-                          c.outside[rows])
+    g_full[r[:, None], c.cols] = c.grad
+    h_full[r[:, None, None], c.cols[:, :, None], c.cols[:, None, :]] = c.hess
+    return PairKinematics(c.gap, g_full, h_full, c.sliding, c.xi, c.segment, c.outside)
 
 
 def _projection_residual(ξ, l, xa, U, W, xs, ws):
@@ -598,3 +601,38 @@ def penalty_response(
     K = (-dp * A)[:, None, None] * k.grad[:, :, None] * k.grad[:, None, :]
     K -= (p * A)[:, None, None] * k.hess
     return f, K, p, k
+
+
+def compact_response(
+    pairs: ContactPairs, u_full: np.ndarray, penalty: float, smoothing: float = 0.0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, PairKinematics, np.ndarray]:
+    """Closest-point pairs: :func:`penalty_response` on each pair's chosen segment only.
+
+    Returns forces (m, 10), tangents (m, 10, 10), pressures (m,), the kinematics (gap,
+    sliding, ξ, segment, outside; gradient and Hessian on the 10 DOFs) and the 10 DOFs'
+    columns in the pair's block (``block_dofs``). The same numbers as the blocks of
+    :func:`penalty_response` at those DOFs (its other entries are zero), without forming the
+    (m, n, n) blocks: on a fine mesh the 1 mm reach spans dozens of segments.
+    """
+    if pairs.search != "closest-point":
+        raise ValueError("compact_response is for closest-point pairs")
+    c = _own_compact(pairs, u_full)
+    p, dp = pressure_law(c.gap, penalty, smoothing)  # eq. (41): contact pressure, MPa
+    A = pairs.area
+    f = -(p * A)[:, None] * c.grad
+    K = (-dp * A)[:, None, None] * c.grad[:, :, None] * c.grad[:, None, :]
+    K -= (p * A)[:, None, None] * c.hess
+    k = PairKinematics(c.gap, c.grad, c.hess, c.sliding, c.xi, c.segment, c.outside)
+    return f, K, p, k, c.cols
+
+
+def contact_state(
+    pairs: ContactPairs, u_full: np.ndarray, penalty: float, smoothing: float = 0.0
+) -> tuple[np.ndarray, PairKinematics]:
+    """Pressures (m,) MPa and kinematics of the pairs (gap, sliding, …), without the blocks.
+
+    Closest-point pairs through :func:`compact_response` (no (m, n, n) block is formed).
+    """
+    if pairs.search == "closest-point":
+        return compact_response(pairs, u_full, penalty, smoothing)[2:4]
+    return penalty_response(pairs, u_full, penalty, smoothing)[2:4]

@@ -143,7 +143,8 @@ def linear_estimate(
                          "error (are the loads and supports right?)")
     estimate = abs(c_up - c_cur) / abs(c_up)
     d_full = up.expand(u_up - transfer(u, cur, up))
-    η = element_energies(up, up.full_response(np.zeros(up.dof_map.n_full))[1], d_full)
+    η = element_energies(up, up.full_response(np.zeros(up.dof_map.n_full),
+                                              contact_blocks=False)[1], d_full)
     return estimate, (η * (estimate / η.sum()) if η.sum() > 0 else η)
 
 

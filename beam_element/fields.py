@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from beam_element.contact import NORMAL_SIGN, penalty_response, pressure_law
+from beam_element.contact import NORMAL_SIGN, contact_state, pressure_law
 from beam_element.kinematics import gradients, green_lagrange, linear_strains
 from beam_element.model import BeamModel
 
@@ -120,7 +120,7 @@ def profile_columns(
         for pairs in model.pairs:
             if pairs.interface == interface:
                 if nonlinear:
-                    _, _, p, k = penalty_response(pairs, u_full, model.penalty, model.smoothing)
+                    p, k = contact_state(pairs, u_full, model.penalty, model.smoothing)
                     gap = k.gap
                 else:  # the linear analysis' law: plain penalty on the linearised gap
                     v = u_full[pairs.dofs]

@@ -54,7 +54,7 @@ from sandwich.solver.jit import njit
 
 __all__ = ["KernelOperators", "block_pattern", "block_slots", "embed_pattern", "kernel_operators",
            "layer_assemble", "layer_blocks", "layer_flops", "layer_response", "point_flops",
-           "scatter_blocks", "supports", "uses_sum_factorisation"]
+           "scatter_blocks", "scatter_compact", "supports", "uses_sum_factorisation"]
 
 
 @dataclass(frozen=True)
@@ -292,6 +292,34 @@ def block_slots(free, indptr, indices, n, out):  # pragma: no cover - compiled
                 out[b, i, j] = pos[c] if c >= 0 else -1
             for p in range(indptr[r], indptr[r + 1]):
                 pos[indices[p]] = -1
+
+
+@njit
+def scatter_compact(free, sign, K, indptr, indices, data):  # pragma: no cover - compiled
+    """Add blocks K (B, m, m) on reduced DOFs ``free`` (B, m) into the CSR values ``data``.
+
+    ``free`` −1: eliminated; ``sign``: each DOF's sign; each slot is found by a binary search
+    in its row.
+    """
+    B, m = free.shape
+    for b in range(B):
+        for i in range(m):
+            r = free[b, i]
+            if r < 0:
+                continue
+            lo0, hi0 = indptr[r], indptr[r + 1]
+            for j in range(m):
+                c = free[b, j]
+                if c < 0:
+                    continue
+                lo, hi = lo0, hi0
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if indices[mid] < c:
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                data[lo] += sign[b, i] * sign[b, j] * K[b, i, j]
 
 
 @njit

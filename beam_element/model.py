@@ -20,7 +20,9 @@ from beam_element.constraints import DofMap, NodeSupport, build_dof_map
 from beam_element.contact import (
     DEFAULT_REACH,
     ContactPairs,
+    compact_response,
     contact_pair_groups,
+    contact_state,
     in_contact,
     penalty_response,
 )
@@ -351,27 +353,40 @@ class BeamModel:
         self, u_full: np.ndarray, kernels: object
     ) -> tuple[np.ndarray, _Assembled]:
         """Force and reduced tangent in one pass: layers by the kernels, contact by NumPy."""
-        slots = self.pattern.family_slots  # block families: _families(), then the contact pairs
-        data = np.zeros(self.pattern.indices.size)
+        pattern = self.pattern  # block families: _families(), then the contact pairs
+        data = np.zeros(pattern.indices.size)
         lengths = self.mesh.lengths
         forces = []
         families = self._families()
         for i, (op, products, els, dofs) in enumerate(families):
             if kernels.supports(op):
                 forces.append(kernels.layer_assemble(op, u_full[dofs], lengths[els], self.width,
-                                                     *slots[i], data))
+                                                     *pattern.slots_of(i), data))
                 continue
             u_e = np.zeros((els.size, int(op.dofs.max()) + 1))  # membrane_average: NumPy path
             u_e[:, op.dofs] = u_full[dofs]
             st = layer_state(op, u_e, lengths[els], self.width)
             forces.append(st.f)
-            kernels.scatter_blocks(layer_tangent(op, st, products), *slots[i], data)
+            kernels.scatter_blocks(layer_tangent(op, st, products), *pattern.slots_of(i), data)
         contact = []
         for j, pairs in enumerate(self.pairs, start=len(families)):
+            if pairs.search == "closest-point":  # on each pair's chosen segment only
+                f10, K10, p, k, cols = compact_response(pairs, u_full, self.penalty,
+                                                        self.smoothing)
+                f = np.zeros(pairs.support_dofs.shape)
+                np.put_along_axis(f, cols, f10, axis=1)
+                forces.append(f)
+                dofs10 = np.take_along_axis(pairs.support_dofs, cols, axis=1)
+                contact.append((p, k))
+                free = np.ascontiguousarray(self.dof_map.free[dofs10], dtype=np.int64)
+                sign = np.where(free >= 0, self.dof_map.sign[dofs10], 0).astype(np.int8)
+                kernels.scatter_compact(free, sign, np.ascontiguousarray(K10),
+                                        pattern.indptr, pattern.indices, data)
+                continue
             f, K, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(f)
             contact.append((p, k))
-            kernels.scatter_blocks(np.ascontiguousarray(K), *slots[j], data)
+            kernels.scatter_blocks(np.ascontiguousarray(K), *pattern.slots_of(j), data)
         n = self.pattern.n
         K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
         return scatter_vector(u_full.size, self.block_dofs, forces), _Assembled(K, contact)
@@ -387,12 +402,14 @@ class BeamModel:
         return blocks
 
     def full_response(
-        self, u_full: np.ndarray, tangent: bool = True
+        self, u_full: np.ndarray, tangent: bool = True, contact_blocks: bool = True
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Internal force on the full DOFs and the local tangent blocks (layers, then contact).
 
         Layers by the compiled kernels (block output) when :attr:`use_kernels` and numba allow,
-        else by the NumPy reference path (:mod:`beam_element.element`).
+        else by the NumPy reference path (:mod:`beam_element.element`). Without ``tangent``
+        (or with ``contact_blocks`` False: the layer blocks only) no closest-point pair's
+        (m, n, n) block is formed.
         """
         kernels = _kernels() if self.use_kernels else None
         if kernels is None:
@@ -411,9 +428,17 @@ class BeamModel:
             forces.append(f)
             blocks.append(K)
         for pairs in self.pairs:
+            if pairs.search == "closest-point" and not (tangent and contact_blocks):
+                f10, _, _, _, cols = compact_response(pairs, u_full, self.penalty,
+                                                      self.smoothing)
+                f = np.zeros(pairs.support_dofs.shape)
+                np.put_along_axis(f, cols, f10, axis=1)
+                forces.append(f)
+                continue
             f, K, _, _ = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(f)
-            blocks.append(K)
+            if contact_blocks:
+                blocks.append(K)
         return scatter_vector(u_full.size, self.block_dofs, forces), (blocks if tangent else [])
 
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
@@ -427,7 +452,7 @@ class BeamModel:
             if known is not None:
                 p, k = known[i]
             else:
-                _, _, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
+                p, k = contact_state(pairs, u_full, self.penalty, self.smoothing)
             active = in_contact(k.gap, self.smoothing)
             c = out.setdefault(pairs.interface, ContactSummary())
             c.max_penetration = max(c.max_penetration, float(np.max(-k.gap, initial=0.0)))

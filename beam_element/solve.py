@@ -185,6 +185,20 @@ def _min_increment(model: BeamModel, analysis: object) -> float | None:
     return None
 
 
+def scene_model_options(scene: object) -> dict[str, object]:
+    """The :func:`~beam_element.model.build_model` options a scene's ``[beam_model]`` sets.
+
+    Grading, face membrane, contact search, core basis and faces (the element choices; the
+    core levels are chosen by :func:`choose_core_levels`).
+    """
+    bm = scene.beam_model
+    return {"grading": getattr(bm, "grading", "graded"),
+            "face_membrane": getattr(bm, "face_membrane", "averaged"),
+            "contact_search": getattr(bm, "contact_search", "closest-point"),
+            "core_basis": getattr(bm, "core_basis", "sublayers"),
+            "face_stretch": getattr(bm, "faces", "stretch") == "stretch"}
+
+
 def run(
     scene: Scene,
     progress: Callable[[object], None] | None = None,
@@ -210,12 +224,7 @@ def run(
     if a.kind not in ("linear", "nonlinear"):
         raise ValueError(f"analysis kind must be 'linear' or 'nonlinear', got {a.kind!r}")
     bm = scene.beam_model
-    options = {"grading": getattr(bm, "grading", "graded"),
-               "face_membrane": getattr(bm, "face_membrane", "averaged"),
-               "contact_search": getattr(bm, "contact_search", "closest-point"),
-               "core_basis": getattr(bm, "core_basis", "sublayers"),
-               "face_stretch": getattr(bm, "faces", "stretch") == "stretch",
-               **(model_options or {})}
+    options = {**scene_model_options(scene), **(model_options or {})}
     choice = choose_core_levels(scene, elements, options)
     nonlinear = a.kind == "nonlinear"
     limit_points: list[LimitPoint] = []

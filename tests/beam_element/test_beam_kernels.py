@@ -201,6 +201,9 @@ def _contact_state(model, rng):
 @pytest.mark.parametrize("options", [
     {}, {"core_level": 3}, {"core_level": 2, "core_basis": "polynomial"},
     {"face_membrane": "averaged"}, {"contact_search": "closest-point"},
+    # several candidate segments per pair, grouped by width: the compiled path assembles each
+    # pair on its chosen segment only (contact.compact_response, kernels.scatter_compact)
+    {"contact_search": "closest-point", "contact_reach": 9.0, "grading": "graded"},
 ])
 def test_model_compiled_path_matches_numpy_path(options):
     scene = sandwich_scene(length=60.0, elements=16,
