@@ -235,6 +235,25 @@ def _kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols,
 
 
 @njit
+def _row_union(r, bptr, bdofs, inc_ptr, inc_block, mark, out, start, write):  # pragma: no cover
+    """Columns of row r, the union of its blocks' DOFs: how many (written from ``out[start]``).
+
+    Written only if ``write``; ``mark[j] == r`` flags column j as already seen for this row.
+    """
+    c = 0
+    for t in range(inc_ptr[r], inc_ptr[r + 1]):
+        g = inc_block[t]
+        for q in range(bptr[g], bptr[g + 1]):
+            j = bdofs[q]
+            if j >= 0 and mark[j] != r:
+                mark[j] = r
+                if write:
+                    out[start + c] = j
+                c += 1
+    return c
+
+
+@njit
 def block_pattern(bptr, bdofs, inc_ptr, inc_block, n):  # pragma: no cover - compiled
     """Canonical CSR pattern (indptr, indices) of the union of dense blocks.
 
@@ -245,27 +264,12 @@ def block_pattern(bptr, bdofs, inc_ptr, inc_block, n):  # pragma: no cover - com
     mark = np.full(n, -1, dtype=np.int64)
     indptr = np.zeros(n + 1, dtype=np.int64)
     for r in range(n):  # count
-        c = 0
-        for t in range(inc_ptr[r], inc_ptr[r + 1]):
-            g = inc_block[t]
-            for q in range(bptr[g], bptr[g + 1]):
-                j = bdofs[q]
-                if j >= 0 and mark[j] != r:
-                    mark[j] = r
-                    c += 1
-        indptr[r + 1] = indptr[r] + c
+        indptr[r + 1] = indptr[r] + _row_union(r, bptr, bdofs, inc_ptr, inc_block, mark,
+                                               indptr, indptr[r], False)
     indices = np.empty(indptr[n], dtype=np.int64)
     mark[:] = -1
     for r in range(n):  # fill and sort
-        p = indptr[r]
-        for t in range(inc_ptr[r], inc_ptr[r + 1]):
-            g = inc_block[t]
-            for q in range(bptr[g], bptr[g + 1]):
-                j = bdofs[q]
-                if j >= 0 and mark[j] != r:
-                    mark[j] = r
-                    indices[p] = j
-                    p += 1
+        _row_union(r, bptr, bdofs, inc_ptr, inc_block, mark, indices, indptr[r], True)
         indices[indptr[r]:indptr[r + 1]] = np.sort(indices[indptr[r]:indptr[r + 1]])
     return indptr, indices
 

@@ -249,7 +249,10 @@ def _canonical_csr(K: object) -> sp.csr_matrix:
 
 @njit
 def _count_flops(first, n):  # pragma: no cover - compiled
-    """Operations of :func:`_ldlt`: 2 per inner multiply-add, 3 per off-diagonal (L, d)."""
+    """Operations of :func:`_ldlt`: 2 per inner multiply-add, 3 per off-diagonal (L, d).
+
+    ``first``: the rows' first columns (a structure's, or the values' ``lo`` of one matrix).
+    """
     total = 0
     for i in range(n):
         fi = first[i]
@@ -295,18 +298,6 @@ def _numerical_first(env, rowptr, first, n):  # pragma: no cover - compiled
             p += 1
         lo[i] = first[i] + (p - rowptr[i])
     return lo
-
-
-@njit
-def _numerical_flops(lo, n):  # pragma: no cover - compiled
-    """Operations of :func:`_ldlt` on the numerical envelope ``lo`` (as :func:`_count_flops`)."""
-    total = 0
-    for i in range(n):
-        fi = lo[i]
-        for j in range(fi, i):
-            k0 = fi if fi > lo[j] else lo[j]
-            total += 2 * (j - k0) + 3
-    return total
 
 
 @njit(reassociate=True)
@@ -483,7 +474,7 @@ class EnvelopeFactorization:
         """Operations this factorisation did: the numerical envelope's for ``"envelope"``."""
         if self.structure.storage == "columns":
             return self.structure.flops
-        return float(_numerical_flops(self._lo, self.size))
+        return float(_count_flops(self._lo, self.size))  # the same count on the values' rows
 
     @property
     def negative_pivots(self) -> int:
