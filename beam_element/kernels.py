@@ -303,8 +303,9 @@ def scatter_compact(free, sign, K, indptr, indices, data):  # pragma: no cover -
     """Add blocks K (B, m, m) on reduced DOFs ``free`` (B, m) into the CSR values ``data``.
 
     ``free`` −1: eliminated; ``sign``: each DOF's sign; each slot is found by a binary search
-    in its row.
+    in its row. Returns how many entries have no slot in the pattern (not added).
     """
+    misses = 0
     B, m = free.shape
     for b in range(B):
         for i in range(m):
@@ -323,7 +324,11 @@ def scatter_compact(free, sign, K, indptr, indices, data):  # pragma: no cover -
                         lo = mid + 1
                     else:
                         hi = mid
-                data[lo] += sign[b, i] * sign[b, j] * K[b, i, j]
+                if lo < hi0 and indices[lo] == c:
+                    data[lo] += sign[b, i] * sign[b, j] * K[b, i, j]
+                else:
+                    misses += 1
+    return misses
 
 
 @njit

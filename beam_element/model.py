@@ -168,8 +168,42 @@ class BeamModel:
         self.block_dofs += [g.dofs for g in self.core]
         self.block_dofs += [faces["bottom"]]
         self.block_dofs += [p.block_dofs for p in self.pairs]
-        self.pattern = reduced_pattern(self.block_dofs, self.dof_map)
+        # The compiled path's pattern: the layers, and of each closest-point pair only the
+        # segments next to its node (it grows by the segments its projections meet, see
+        # _grow_pattern); the NumPy path assembles on every searched segment (full_pattern).
+        self._pattern_families = self.block_dofs[:len(self.block_dofs) - len(self.pairs)]
+        self._pattern_families += [_seed_dofs(p) for p in self.pairs]
+        self._contact_met: list[np.ndarray] = []
+        self.pattern = reduced_pattern(self._pattern_families, self.dof_map)
         self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
+
+    @property
+    def full_pattern(self) -> ReducedPattern:
+        """The pattern of every block family on its whole DOF list (the NumPy path's).
+
+        For closest-point pairs: all searched segments. Built on first use.
+        """
+        if "_full_pattern" not in self.__dict__:
+            self.__dict__["_full_pattern"] = (
+                self.pattern if not any(p.search == "closest-point" for p in self.pairs)
+                else reduced_pattern(self.block_dofs, self.dof_map))
+        return self.__dict__["_full_pattern"]
+
+    def _grow_pattern(self, dofs: np.ndarray) -> None:
+        """Add contact blocks on full DOFs ``dofs`` (B, 10) to the compiled path's pattern.
+
+        Called when a closest-point projection lands on a segment the pattern lacks; the
+        segments met are kept (the pattern only grows), the slot maps and the factorisation
+        structures of the old pattern are dropped.
+        """
+        met = np.unique(np.sort(dofs, axis=1), axis=0)
+        if self._contact_met:
+            met = np.unique(np.concatenate([self._contact_met[0], met]), axis=0)
+        self._contact_met = [met]
+        self.pattern = reduced_pattern(self._pattern_families + self._contact_met,
+                                       self.dof_map)
+        self.__dict__.pop("_envelopes", None)
+        self.pattern_growths = getattr(self, "pattern_growths", 0) + 1
 
     @property
     def face_extra(self) -> int:
@@ -300,7 +334,7 @@ class BeamModel:
             if not tangent or cache[2] is not None:
                 return cache[1], cache[2]
             # The force at this u is known: the tangent reuses its strains and stresses.
-            K = self.pattern.assemble(self._tangent_blocks(self.expand(u), cache[3]))
+            K = self.full_pattern.assemble(self._tangent_blocks(self.expand(u), cache[3]))
             self._cache = (cache[0], cache[1], K, cache[3])
             return cache[1], K
         u_full = self.expand(u)
@@ -309,7 +343,8 @@ class BeamModel:
         if isinstance(states, _Assembled):  # compiled path: the tangent came with the force
             K = states.K
         else:
-            K = self.pattern.assemble(self._tangent_blocks(u_full, states)) if tangent else None
+            K = (self.full_pattern.assemble(self._tangent_blocks(u_full, states)) if tangent
+                 else None)
         self._cache = (np.array(u, dtype=float, copy=True), f, K, states)
         return f, K
 
@@ -352,7 +387,11 @@ class BeamModel:
     def _compiled_forces(
         self, u_full: np.ndarray, kernels: object
     ) -> tuple[np.ndarray, _Assembled]:
-        """Force and reduced tangent in one pass: layers by the kernels, contact by NumPy."""
+        """Force and reduced tangent in one pass: layers by the kernels, contact compact.
+
+        A closest-point pair whose chosen segment the pattern lacks grows it
+        (:meth:`_grow_pattern`) and the pass is made again on the grown pattern.
+        """
         pattern = self.pattern  # block families: _families(), then the contact pairs
         data = np.zeros(pattern.indices.size)
         lengths = self.mesh.lengths
@@ -380,8 +419,10 @@ class BeamModel:
                 contact.append((p, k))
                 free = np.ascontiguousarray(self.dof_map.free[dofs10], dtype=np.int64)
                 sign = np.where(free >= 0, self.dof_map.sign[dofs10], 0).astype(np.int8)
-                kernels.scatter_compact(free, sign, np.ascontiguousarray(K10),
-                                        pattern.indptr, pattern.indices, data)
+                if kernels.scatter_compact(free, sign, np.ascontiguousarray(K10),
+                                           pattern.indptr, pattern.indices, data):
+                    self._grow_pattern(dofs10)
+                    return self._compiled_forces(u_full, kernels)
                 continue
             f, K, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(f)
@@ -467,6 +508,20 @@ class BeamModel:
     def penetration_bound(self) -> float:
         """Allowed penetration (mm): PENETRATION_BOUND × the thinner face."""
         return PENETRATION_BOUND * min(self.face_thickness.values())
+
+
+def _seed_dofs(pairs: ContactPairs) -> np.ndarray:
+    """A contact group's DOFs in the compiled path's first pattern.
+
+    Same-x: the pair's six DOFs. Closest-point: the face node's (u, w) and the core nodes
+    i − 1, i, i + 1 (the segments on either side of the node, where an unslid projection
+    lies).
+    """
+    if pairs.search != "closest-point":
+        return pairs.block_dofs
+    k = pairs.core_nodes.shape[1] // 2  # the node's own slot
+    cols = np.r_[0, 1, np.arange(2 + 4 * (k - 1), 2 + 4 * (k + 2))]
+    return pairs.support_dofs[:, cols]
 
 
 @dataclass(frozen=True)
