@@ -396,6 +396,7 @@ class BeamModel:
         data = np.zeros(pattern.indices.size)
         lengths = self.mesh.lengths
         forces = []
+        force_dofs = list(self.block_dofs)  # a closest-point group's force: on its 10 DOFs
         families = self._families()
         for i, (op, products, els, dofs) in enumerate(families):
             if kernels.supports(op):
@@ -412,10 +413,9 @@ class BeamModel:
             if pairs.search == "closest-point":  # on each pair's chosen segment only
                 f10, K10, p, k, cols = compact_response(pairs, u_full, self.penalty,
                                                         self.smoothing)
-                f = np.zeros(pairs.support_dofs.shape)
-                np.put_along_axis(f, cols, f10, axis=1)
-                forces.append(f)
                 dofs10 = np.take_along_axis(pairs.support_dofs, cols, axis=1)
+                forces.append(f10)
+                force_dofs[j] = dofs10
                 contact.append((p, k))
                 free = np.ascontiguousarray(self.dof_map.free[dofs10], dtype=np.int64)
                 sign = np.where(free >= 0, self.dof_map.sign[dofs10], 0).astype(np.int8)
@@ -430,7 +430,7 @@ class BeamModel:
             kernels.scatter_blocks(np.ascontiguousarray(K), *pattern.slots_of(j), data)
         n = self.pattern.n
         K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
-        return scatter_vector(u_full.size, self.block_dofs, forces), _Assembled(K, contact)
+        return scatter_vector(u_full.size, force_dofs, forces), _Assembled(K, contact)
 
     def _tangent_blocks(
         self, u_full: np.ndarray, states: list[list[LayerState]]
