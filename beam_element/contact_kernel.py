@@ -71,7 +71,6 @@ def closest_point_kernel(xa, l, U, W, xs, ws, x_node, valid, s_n, tol, max_iter,
     H = np.empty((11, 11))
     dg = np.empty(4)
     d2g = np.empty((4, 4))
-    tmp = np.empty((4, 11))
     ξq = np.empty(10)
     for p in range(m):
         best, best_d, best_ξ = -1, np.inf, 0.0
@@ -168,18 +167,7 @@ def closest_point_kernel(xa, l, U, W, xs, ws, x_node, valid, s_n, tol, max_iter,
             J[2, 3 + k] = N[1, k]
             J[3, 7 + k] = N[1, k]
         # H = Jᵀ d2g J + Σ_α g̃_α Z_α (Z: the ξ row and column only)
-        for i in range(4):
-            for j in range(11):
-                t = 0.0
-                for k in range(4):
-                    t += d2g[i, k] * J[k, j]
-                tmp[i, j] = t
-        for i in range(11):
-            for j in range(11):
-                t = 0.0
-                for k in range(4):
-                    t += J[k, i] * tmp[k, j]
-                H[i, j] = t
+        H[:, :] = np.dot(J.T, np.dot(d2g, J))
         H[0, 0] += -dg[0] * aξ - dg[1] * cξ + dg[2] * aξξ + dg[3] * cξξ
         for k in range(4):
             zu = -dg[0] * N[1, k] + dg[2] * N[2, k]
