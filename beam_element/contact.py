@@ -428,13 +428,14 @@ def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     kernel = _closest_point_kernel()
     if kernel is None or pairs.size == 0:
         return _compact_kinematics_numpy(pairs, u_full)
-    xa, l, U, W, xs, ws = _segment_geometry(pairs, u_full)
-    out = kernel(np.ascontiguousarray(xa), np.ascontiguousarray(l), np.ascontiguousarray(U),
-                 np.ascontiguousarray(W), np.ascontiguousarray(xs[:, 0]),
-                 np.ascontiguousarray(ws[:, 0]), np.ascontiguousarray(pairs.x[pairs.nodes]),
-                 np.ascontiguousarray(pairs.segment_valid), NORMAL_SIGN[pairs.interface],
-                 PROJECTION_TOL, PROJECTION_MAX_ITERATIONS, PROJECTION_RESIDUAL_TOL,
-                 IN_SEGMENT_TOL)
+    v_face = u_full[pairs.dofs[:, :2]]  # (m, 2): u_face, w_face
+    core = u_full[pairs.support_dofs[:, 2:]].reshape(pairs.size, -1, 4)  # (m, S + 1, 4)
+    x_node = pairs.x[pairs.nodes]
+    out = kernel(np.ascontiguousarray(pairs.x[pairs.core_nodes]), np.ascontiguousarray(core),
+                 np.ascontiguousarray(x_node + v_face[:, 0]), np.ascontiguousarray(v_face[:, 1]),
+                 np.ascontiguousarray(x_node), np.ascontiguousarray(pairs.segment_valid),
+                 NORMAL_SIGN[pairs.interface], PROJECTION_TOL, PROJECTION_MAX_ITERATIONS,
+                 PROJECTION_RESIDUAL_TOL, IN_SEGMENT_TOL)
     return _Compact(*out)
 
 

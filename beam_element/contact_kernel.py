@@ -50,14 +50,49 @@ def _dot4(a, b):  # pragma: no cover - compiled
 
 
 @njit
-def closest_point_kernel(xa, l, U, W, xs, ws, x_node, valid, s_n, tol, max_iter, res_tol,
-                         seg_tol):  # pragma: no cover - compiled
-    """Kinematics of m pairs over S candidate segments each (arrays (m, S[, 4]), (m,)).
+def _segment(xc, core, p, s, valid, Us, Ws):  # pragma: no cover - compiled
+    """Segment s of pair p: its start x and length, and (U, W) into ``Us``, ``Ws``."""
+    xa = xc[p, s]
+    ls = xc[p, s + 1] - xa if valid[p, s] else 1.0
+    Us[0], Us[1], Us[2], Us[3] = core[p, s, 0], core[p, s, 1], core[p, s + 1, 0], core[p, s + 1, 1]
+    Ws[0], Ws[1], Ws[2], Ws[3] = core[p, s, 2], core[p, s, 3], core[p, s + 1, 2], core[p, s + 1, 3]
+    return xa, ls
 
+
+@njit
+def _hull_distance(xa, ls, Us, Ws, px, pz):  # pragma: no cover - compiled
+    """A lower bound of the distance from (px, pz) to the deformed segment.
+
+    The cubic Hermite curve lies in the convex hull of its Bézier control points P0,
+    P0 + (l/3) X_x(0), P1 − (l/3) X_x(1), P1; the distance to their bounding box bounds the
+    distance to the curve from below.
+    """
+    x0, z0 = xa + Us[0], Ws[0]
+    x3, z3 = xa + ls + Us[2], Ws[2]
+    x1, z1 = x0 + ls / 3 * (1 + Us[1]), z0 + ls / 3 * Ws[1]
+    x2, z2 = x3 - ls / 3 * (1 + Us[3]), z3 - ls / 3 * Ws[3]
+    lo_x, hi_x = min(min(x0, x1), min(x2, x3)), max(max(x0, x1), max(x2, x3))
+    lo_z, hi_z = min(min(z0, z1), min(z2, z3)), max(max(z0, z1), max(z2, z3))
+    dx = lo_x - px if px < lo_x else (px - hi_x if px > hi_x else 0.0)
+    dz = lo_z - pz if pz < lo_z else (pz - hi_z if pz > hi_z else 0.0)
+    return np.hypot(dx, dz)
+
+
+@njit
+def closest_point_kernel(xc, core, xs, ws, x_node, valid, s_n, tol, max_iter, res_tol,
+                         seg_tol):  # pragma: no cover - compiled
+    """Kinematics of m pairs over S candidate segments each.
+
+    ``xc`` (m, S + 1): reference x of each pair's window of core nodes; ``core`` (m, S + 1, 4):
+    their (u, u_x, w, w_x); ``valid`` (m, S): segment s joins slots s and s + 1; ``xs``, ``ws``
+    (m,): the master points; ``x_node`` (m,): the pairs' node x. Segments whose control-point
+    hull is farther from the master point than the best projection found are not searched (it
+    cannot win); the two next to the node are searched first. The choice is the nearest
+    projection on a segment, the lowest segment on a tie — the NumPy path's ``argmin``.
     Returns gap (m,), grad (m, 10), hess (m, 10, 10), cols (m, 10), sliding, ξ, segment,
     outside — the fields of ``beam_element.contact._Compact``.
     """
-    m, S = xa.shape
+    m, S = valid.shape
     gap = np.empty(m)
     grad = np.empty((m, 10))
     hess = np.empty((m, 10, 10))
@@ -72,17 +107,32 @@ def closest_point_kernel(xa, l, U, W, xs, ws, x_node, valid, s_n, tol, max_iter,
     dg = np.empty(4)
     d2g = np.empty((4, 4))
     ξq = np.empty(10)
+    Us = np.empty(4)
+    Ws = np.empty(4)
+    k_own = S // 2  # the node's own slot: segments k_own − 1 and k_own touch it
     for p in range(m):
         best, best_d, best_ξ = -1, np.inf, 0.0
         first_valid, last_valid = -1, -1
         for s in range(S):
-            if not valid[p, s]:
+            if valid[p, s]:
+                if first_valid < 0:
+                    first_valid = s
+                last_valid = s
+        for t in range(S + 2):
+            # the two segments at the node first, then all in order (skipping those two)
+            if t == 0:
+                s = k_own - 1
+            elif t == 1:
+                s = k_own
+            else:
+                s = t - 2
+                if s == k_own - 1 or s == k_own:
+                    continue
+            if s < 0 or s >= S or not valid[p, s]:
                 continue
-            if first_valid < 0:
-                first_valid = s
-            last_valid = s
-            ls, xas = l[p, s], xa[p, s]
-            Us, Ws = U[p, s], W[p, s]
+            xas, ls = _segment(xc, core, p, s, valid, Us, Ws)
+            if best >= 0 and _hull_distance(xas, ls, Us, Ws, xs[p], ws[p]) > best_d:
+                continue
             ξ = min(max((x_node[p] - xas) / ls, 0.0), 1.0)
             for _ in range(max_iter):
                 _hermite(ξ, ls, N)
@@ -107,23 +157,24 @@ def closest_point_kernel(xa, l, U, W, xs, ws, x_node, valid, s_n, tol, max_iter,
             if (abs(φ) <= res_tol * (a * a + c * c) and ξ >= -seg_tol
                     and ξ <= 1 + seg_tol):
                 d = np.hypot(r1, r2)
-                if d < best_d:
+                if d < best_d or (d == best_d and s < best):
                     best, best_d, best_ξ = s, d, ξ
         if best < 0:  # no projection on the searched curve: the nearer end, ξ fixed
             outside[p] = True
             ends = np.empty(2)
             for e, (s, ξe) in enumerate(((first_valid, 0.0), (last_valid, 1.0))):
-                _hermite(ξe, l[p, s], N)
-                Xe = xa[p, s] + l[p, s] * ξe + _dot4(N[0], U[p, s])
-                ends[e] = np.hypot(xs[p] - Xe, ws[p] - _dot4(N[0], W[p, s]))
+                xas, ls = _segment(xc, core, p, s, valid, Us, Ws)
+                _hermite(ξe, ls, N)
+                Xe = xas + ls * ξe + _dot4(N[0], Us)
+                ends[e] = np.hypot(xs[p] - Xe, ws[p] - _dot4(N[0], Ws))
             if ends[1] < ends[0]:
                 best, best_ξ = last_valid, 1.0
             else:
                 best, best_ξ = first_valid, 0.0
         s, ξ = best, best_ξ
-        ls, Us, Ws = l[p, s], U[p, s], W[p, s]
+        xas, ls = _segment(xc, core, p, s, valid, Us, Ws)
         _hermite(ξ, ls, N)
-        r1 = xs[p] - (xa[p, s] + ls * ξ + _dot4(N[0], Us))
+        r1 = xs[p] - (xas + ls * ξ + _dot4(N[0], Us))
         r2 = ws[p] - _dot4(N[0], Ws)
         a, c = ls + _dot4(N[1], Us), _dot4(N[1], Ws)
         aξ, cξ = _dot4(N[2], Us), _dot4(N[2], Ws)
@@ -193,7 +244,7 @@ def closest_point_kernel(xa, l, U, W, xs, ws, x_node, valid, s_n, tol, max_iter,
         cols[p, 0], cols[p, 1] = 0, 1
         cols[p, 2], cols[p, 3], cols[p, 4], cols[p, 5] = base, base + 1, base + 4, base + 5
         cols[p, 6], cols[p, 7], cols[p, 8], cols[p, 9] = base + 2, base + 3, base + 6, base + 7
-        sliding[p] = xa[p, s] + ls * ξ - x_node[p]
+        sliding[p] = xas + ls * ξ - x_node[p]
         xi_out[p] = ξ
         seg_out[p] = s
     return gap, grad, hess, cols, sliding, xi_out, seg_out, outside
