@@ -596,12 +596,20 @@ def penalty_response(
     ``smoothing`` is the regularisation width s (mm) of :func:`pressure_law`.
     """
     k = pair_kinematics(pairs, u_full)
-    p, dp = pressure_law(k.gap, penalty, smoothing)  # eq. (41): contact pressure, MPa
-    A = pairs.area
-    f = -(p * A)[:, None] * k.grad
-    K = (-dp * A)[:, None, None] * k.grad[:, :, None] * k.grad[:, None, :]
-    K -= (p * A)[:, None, None] * k.hess
+    f, K, p = _penalty_blocks(k.gap, k.grad, k.hess, pairs.area, penalty, smoothing)
     return f, K, p, k
+
+
+def _penalty_blocks(
+    gap: np.ndarray, grad: np.ndarray, hess: np.ndarray, area: np.ndarray, penalty: float,
+    smoothing: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Force −p A ∂g, tangent −A p'(g) ∂g ∂gᵀ − p A ∂²g and pressure p of each pair."""
+    p, dp = pressure_law(gap, penalty, smoothing)  # eq. (41): contact pressure, MPa
+    f = -(p * area)[:, None] * grad
+    K = (-dp * area)[:, None, None] * grad[:, :, None] * grad[:, None, :]
+    K -= (p * area)[:, None, None] * hess
+    return f, K, p
 
 
 def compact_response(
@@ -618,11 +626,7 @@ def compact_response(
     if pairs.search != "closest-point":
         raise ValueError("compact_response is for closest-point pairs")
     c = _own_compact(pairs, u_full)
-    p, dp = pressure_law(c.gap, penalty, smoothing)  # eq. (41): contact pressure, MPa
-    A = pairs.area
-    f = -(p * A)[:, None] * c.grad
-    K = (-dp * A)[:, None, None] * c.grad[:, :, None] * c.grad[:, None, :]
-    K -= (p * A)[:, None, None] * c.hess
+    f, K, p = _penalty_blocks(c.gap, c.grad, c.hess, pairs.area, penalty, smoothing)
     k = PairKinematics(c.gap, c.grad, c.hess, c.sliding, c.xi, c.segment, c.outside)
     return f, K, p, k, c.cols
 

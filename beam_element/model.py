@@ -174,6 +174,7 @@ class BeamModel:
         self._pattern_families = self.block_dofs[:len(self.block_dofs) - len(self.pairs)]
         self._pattern_families += [_seed_dofs(p) for p in self.pairs]
         self._contact_met: list[np.ndarray] = []
+        self.pattern_growths = 0  # how many times _grow_pattern widened the pattern
         self.pattern = reduced_pattern(self._pattern_families, self.dof_map)
         self.f_ref_free = self.dof_map.reduce(self.f_ref_full)
 
@@ -203,7 +204,7 @@ class BeamModel:
         self.pattern = reduced_pattern(self._pattern_families + self._contact_met,
                                        self.dof_map)
         self.__dict__.pop("_envelopes", None)
-        self.pattern_growths = getattr(self, "pattern_growths", 0) + 1
+        self.pattern_growths += 1
 
     @property
     def face_extra(self) -> int:

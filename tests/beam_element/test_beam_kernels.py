@@ -247,7 +247,7 @@ def test_compiled_pattern_grows_to_the_segments_projections_meet():
     before = model.pattern.indices.size
     model._cache = None
     f1, K1 = model.internal_force(u), model.tangent(u)
-    assert getattr(model, "pattern_growths", 0) >= 1 and model.pattern.indices.size > before
+    assert model.pattern_growths >= 1 and model.pattern.indices.size > before
     k = model.contact_summary(u)["top"]
     assert k.active > 0
     model.use_kernels = False
