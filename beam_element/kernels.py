@@ -34,6 +34,7 @@ first) where that saves enough flops (:func:`uses_sum_factorisation`): the enric
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -76,11 +77,6 @@ class KernelOperators:
     MwT: np.ndarray  # (n_w, 2G)
     Nu: np.ndarray  # (2G, n_u): force f_u = c @ Nu
     Mw: np.ndarray  # (2G, n_w)
-    Quu: np.ndarray  # (3G, n_u (n_u + 1) / 2), rows (00 | 11 | 01) per point
-    Qww: np.ndarray  # (3G, n_w (n_w + 1) / 2), rows (22 | 33 | 23)
-    Quw: np.ndarray  # (4G, n_u n_w), rows (02 | 03 | 12 | 13)
-    pu: np.ndarray  # (2, n_u (n_u + 1) / 2): (a, b) of each packed uu pair, a ≤ b
-    pw: np.ndarray  # (2, n_w (n_w + 1) / 2)
     ucols: np.ndarray  # (n_u,) positions of the u columns in the layer's DOFs
     wcols: np.ndarray  # (n_w,)
     dofs: np.ndarray  # (n,) element-local DOF indices
@@ -88,6 +84,45 @@ class KernelOperators:
     weight: np.ndarray  # (G,)
     stiffness: np.ndarray  # (3, 3)
     thickness: float
+
+    # The packed products (below) are formed on first use: a layer that the sum-factorised
+    # kernel evaluates (core levels 2-4) never needs them (level 3: 4.5 MB per layer).
+    @property
+    def G(self) -> int:
+        """Number of points."""
+        return self.weight.size
+
+    @cached_property
+    def Quu(self) -> np.ndarray:
+        """(3G, n_u (n_u + 1) / 2), rows (00 | 11 | 01) per point."""
+        return self._packed[0][0]
+
+    @cached_property
+    def pu(self) -> np.ndarray:
+        """(2, n_u (n_u + 1) / 2): (a, b) of each packed uu pair, a ≤ b."""
+        return self._packed[0][1]
+
+    @cached_property
+    def Qww(self) -> np.ndarray:
+        """(3G, n_w (n_w + 1) / 2), rows (22 | 33 | 23)."""
+        return self._packed[1][0]
+
+    @cached_property
+    def pw(self) -> np.ndarray:
+        """(2, n_w (n_w + 1) / 2)."""
+        return self._packed[1][1]
+
+    @cached_property
+    def Quw(self) -> np.ndarray:
+        """(4G, n_u n_w), rows (02 | 03 | 12 | 13)."""
+        return self._packed[2][0]
+
+    @cached_property
+    def _packed(self) -> tuple:
+        G = self.G
+        N0, N1, M0, M1 = self.Nu[:G], self.Nu[G:], self.Mw[:G], self.Mw[G:]
+        return (_packed_products(N0, N1, N0, N1, True), _packed_products(M0, M1, M0, M1, True),
+                _packed_products(N0, N1, M0, M1, False))
 
 
 def supports(op: LayerOperators) -> bool:
@@ -125,14 +160,10 @@ def kernel_operators(op: LayerOperators) -> KernelOperators:
         raise ValueError(f"{op.name}: N rows must vanish on w columns and M rows on u columns")
     N0, N1 = op.N_eta[:, ucols], op.N_xi[:, ucols]
     M0, M1 = op.M_eta[:, wcols], op.M_xi[:, wcols]
-    Quu, pu = _packed_products(N0, N1, N0, N1, True)
-    Qww, pw = _packed_products(M0, M1, M0, M1, True)
-    Quw, _ = _packed_products(N0, N1, M0, M1, False)
     Nu = np.ascontiguousarray(np.concatenate([N0, N1]))
     Mw = np.ascontiguousarray(np.concatenate([M0, M1]))
     k = KernelOperators(
         NuT=np.ascontiguousarray(Nu.T), MwT=np.ascontiguousarray(Mw.T), Nu=Nu, Mw=Mw,
-        Quu=Quu, Qww=Qww, Quw=Quw, pu=pu, pw=pw,
         ucols=ucols.astype(np.int64), wcols=wcols.astype(np.int64),
         dofs=np.asarray(op.dofs, dtype=np.int64), x_slope=np.asarray(op.x_slope, dtype=np.bool_),
         weight=np.ascontiguousarray(op.weight, dtype=float),
