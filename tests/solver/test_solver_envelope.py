@@ -226,3 +226,35 @@ def test_kernels_run_from_a_read_only_install(tmp_path):
                          timeout=300, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["temporary", "1", "True"]
+
+
+@pytest.mark.parametrize("numeric", [False, True])
+def test_structure_of_an_unsymmetric_pattern_is_its_symmetric_closure(numeric):
+    """first[i] against a dense brute force: the smallest column coupled to row i in K or Kᵀ
+    (non-zero values only when ``numeric``), on a pattern with explicit zeros and rows without
+    a diagonal slot; every stored CSR entry maps into the storage or (numeric) is zero."""
+    rng = np.random.default_rng(5)
+    n = 60
+    A = sp.random(n, n, density=0.06, random_state=rng, format="csr")
+    A.data[rng.random(A.nnz) < 0.3] = 0.0  # explicit zeros
+    A = A.tolil()
+    A.setdiag(0.0)
+    A = A.tocsr()  # no diagonal slots at all
+    A.sort_indices()
+    dense = A.toarray()
+    coupled = (dense != 0.0) if numeric else (
+        sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape).toarray() != 0)
+    coupled = coupled | coupled.T | np.eye(n, dtype=bool)
+    s = EnvelopeStructure.of(A, numeric=numeric)
+    inv = np.empty(n, dtype=int)
+    inv[s.order] = np.arange(n)
+    P = coupled[np.ix_(s.order, s.order)]  # new numbering
+    expected = np.array([np.flatnonzero(P[i, : i + 1])[0] for i in range(n)])
+    np.testing.assert_array_equal(s.first, expected)
+    rows = np.repeat(np.arange(n), np.diff(A.indptr))
+    i, j = inv[rows[s.slots]], inv[A.indices[s.slots]]
+    upper = s.storage == "columns"
+    assert np.all(j >= i) if upper else np.all(j <= i)
+    outside = s.positions < 0
+    assert not numeric or np.all(A.data[s.slots[outside]] == 0.0)
+    assert numeric or not np.any(outside)
