@@ -363,6 +363,19 @@ def scatter_compact(free, sign, K, indptr, indices, data):  # pragma: no cover -
 
 
 @njit
+def abs_matvec(indptr, indices, data, x):  # pragma: no cover - compiled
+    """|K| |x| for CSR ``K``: row sums in CSR order, as scipy's ``abs(K) @ abs(x)`` (no copy)."""
+    n = indptr.size - 1
+    y = np.zeros(n)
+    for i in range(n):
+        s = 0.0
+        for t in range(indptr[i], indptr[i + 1]):
+            s += abs(data[t]) * abs(x[indices[t]])
+        y[i] = s
+    return y
+
+
+@njit
 def embed_pattern(indptr, indices, k_indptr, k_indices, k_data, out):  # pragma: no cover
     """Values of a CSR matrix K placed on a larger CSR pattern (both with sorted rows).
 

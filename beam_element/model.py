@@ -246,8 +246,12 @@ class BeamModel:
         at this level once the increment has converged (:mod:`sandwich.solver.newton`).
         """
         K = self.tangent(u)
-        absK = abs(K)
-        return float(np.finfo(float).eps * np.linalg.norm(absK @ np.abs(u)))
+        kernels = _kernels()
+        if kernels is None:
+            product = abs(K) @ np.abs(u)
+        else:  # the same sums without copying K
+            product = kernels.abs_matvec(K.indptr, K.indices, K.data, np.asarray(u, dtype=float))
+        return float(np.finfo(float).eps * np.linalg.norm(product))
 
     def factorize(self, K: sp.spmatrix) -> object:
         """Envelope LDLᵀ of the tangent with its inertia (:mod:`sandwich.solver.envelope`).

@@ -269,6 +269,9 @@ def test_compiled_force_carries_its_tangent():
     K = model._cache[2]
     assert K is not None and model.tangent(u) is K
     assert model.residual_roundoff(u) > 0 and model.tangent(u) is K
+    # ε ‖ |K| |u| ‖ as scipy forms it (the compiled row sums take the same order)
+    assert model.residual_roundoff(u) == float(np.finfo(float).eps
+                                               * np.linalg.norm(abs(K) @ np.abs(u)))
 
 
 def test_contact_summary_reuses_the_evaluation_and_agrees():
