@@ -403,45 +403,115 @@ def _ldlt(env, rowptr, first, lo, n, w):  # pragma: no cover - compiled
 
 
 @njit
+def _scale_column(env, cj, m, d):  # pragma: no cover - compiled
+    """l_ij = (L D)_ij / d_j in place for the m entries below column j's diagonal.
+
+    Returns max |(L D)_ij| and max |l_ij| (the growth tests).
+    """
+    ldmax = 0.0
+    lmax = 0.0
+    for k in range(1, m + 1):
+        a = abs(env[cj + k])
+        if a > ldmax:
+            ldmax = a
+        env[cj + k] /= d
+        a = abs(env[cj + k])
+        if a > lmax:
+            lmax = a
+    return ldmax, lmax
+
+
+@njit
+def _column_update(env, colptr, last, j, q):  # pragma: no cover - compiled
+    """Column q (> j, ≤ last[j]) loses l_qj d_j l_(q..last_j) j: one contiguous AXPY."""
+    cj = colptr[j]
+    c = env[cj + (q - j)] * env[cj]
+    dst = env[colptr[q]:colptr[q] + last[j] - q + 1]
+    src = env[cj + (q - j):cj + last[j] - j + 1]
+    for r in range(last[j] - q + 1):
+        dst[r] -= c * src[r]
+
+
+@njit
 def _column_ldlt(env, colptr, last, n):  # pragma: no cover - compiled
     """In-place LDLᵀ in column storage, env[colptr[j] + (i − j)] = K[i, j] (right-looking).
 
     Column j: d_j = K[j, j], l_ij = K[i, j] / d_j, then every later column k ≤ last[j] loses
-    l_kj d_j l_(k..last_j) j: contiguous AXPYs. Same returns as :func:`_ldlt`.
+    l_kj d_j l_(k..last_j) j. Columns go in panels of four: a panel's columns are factorised
+    and update each other one by one (AXPYs), then every later column they reach loses the
+    four columns' terms in one pass (a rank-4 update: each entry of the trailing column is
+    read and written once, not four times; last[j] is non-decreasing, so the rows split into
+    stretches reached by 4, 3, 2 and 1 of the panel's columns). The same factorisation as
+    column by column, the sums of the four terms in another order (round-off). Same returns
+    as :func:`_ldlt`.
     """
     negative = 0
     finite = True
     dmin = np.inf
     ldmax = 0.0
     lmax = 0.0
-    for j in range(n):
-        cj = colptr[j]
-        d = env[cj]
-        ad = abs(d)
-        if not (ad <= 1.0e308):
-            finite = False
-        if ad < dmin:
-            dmin = ad
-        if ad > ldmax:
-            ldmax = ad
-        if d < 0.0:
-            negative += 1
-        m = last[j] - j
-        for k in range(1, m + 1):
-            a = abs(env[cj + k])  # (L D)_(j+k) j
-            if a > ldmax:
-                ldmax = a
-            env[cj + k] /= d
-            a = abs(env[cj + k])
-            if a > lmax:
-                lmax = a
-        col = env[cj:cj + m + 1]
-        for k in range(1, m + 1):
-            c = col[k] * d
-            dst = env[colptr[j + k]:colptr[j + k] + m - k + 1]  # column j + k, rows ≤ last[j]
-            src = col[k:]
-            for r in range(m - k + 1):
-                dst[r] -= c * src[r]
+    j = 0
+    while j < n:
+        w = 4 if j + 4 <= n else 1
+        for p in range(j, j + w):  # the panel's columns, each updating the panel's later ones
+            d = env[colptr[p]]
+            ad = abs(d)
+            if not (ad <= 1.0e308):
+                finite = False
+            if ad < dmin:
+                dmin = ad
+            if ad > ldmax:
+                ldmax = ad
+            if d < 0.0:
+                negative += 1
+            a, b = _scale_column(env, colptr[p], last[p] - p, d)
+            ldmax = a if a > ldmax else ldmax
+            lmax = b if b > lmax else lmax
+            reach = last[p] if w == 1 else min(last[p], j + w - 1)
+            for q in range(p + 1, reach + 1):
+                _column_update(env, colptr, last, p, q)
+        if w == 1:
+            j += 1
+            continue
+        a0, a1, a2, a3 = last[j], last[j + 1], last[j + 2], last[j + 3]
+        c0_, c1_, c2_, c3_ = colptr[j], colptr[j + 1], colptr[j + 2], colptr[j + 3]
+        d0, d1, d2, d3 = env[c0_], env[c1_], env[c2_], env[c3_]
+        for k in range(j + 4, a3 + 1):  # the trailing columns the panel reaches
+            c0 = env[c0_ + (k - j)] * d0 if k <= a0 else 0.0
+            c1 = env[c1_ + (k - j - 1)] * d1 if k <= a1 else 0.0
+            c2 = env[c2_ + (k - j - 2)] * d2 if k <= a2 else 0.0
+            c3 = env[c3_ + (k - j - 3)] * d3
+            ck = colptr[k] - k  # env[ck + r] = column k, row r
+            r = k
+            if r <= a0:  # rows reached by all four columns
+                dst = env[ck + r:ck + a0 + 1]
+                s0 = env[c0_ - j + r:c0_ - j + a0 + 1]
+                s1 = env[c1_ - j - 1 + r:c1_ - j - 1 + a0 + 1]
+                s2 = env[c2_ - j - 2 + r:c2_ - j - 2 + a0 + 1]
+                s3 = env[c3_ - j - 3 + r:c3_ - j - 3 + a0 + 1]
+                for t in range(a0 - r + 1):
+                    dst[t] -= c0 * s0[t] + c1 * s1[t] + c2 * s2[t] + c3 * s3[t]
+                r = a0 + 1
+            if r <= a1:
+                dst = env[ck + r:ck + a1 + 1]
+                s1 = env[c1_ - j - 1 + r:c1_ - j - 1 + a1 + 1]
+                s2 = env[c2_ - j - 2 + r:c2_ - j - 2 + a1 + 1]
+                s3 = env[c3_ - j - 3 + r:c3_ - j - 3 + a1 + 1]
+                for t in range(a1 - r + 1):
+                    dst[t] -= c1 * s1[t] + c2 * s2[t] + c3 * s3[t]
+                r = a1 + 1
+            if r <= a2:
+                dst = env[ck + r:ck + a2 + 1]
+                s2 = env[c2_ - j - 2 + r:c2_ - j - 2 + a2 + 1]
+                s3 = env[c3_ - j - 3 + r:c3_ - j - 3 + a2 + 1]
+                for t in range(a2 - r + 1):
+                    dst[t] -= c2 * s2[t] + c3 * s3[t]
+                r = a2 + 1
+            dst = env[ck + r:ck + a3 + 1]
+            s3 = env[c3_ - j - 3 + r:c3_ - j - 3 + a3 + 1]
+            for t in range(a3 - r + 1):
+                dst[t] -= c3 * s3[t]
+        j += 4
     if not finite:
         dmin = np.nan
     return negative, dmin, ldmax, lmax
