@@ -74,9 +74,12 @@ def evaluate(model, u):
 
 
 def kernel_flops(model) -> float:
-    """Flops of the layer kernels per evaluation (force + tangent GEMMs)."""
-    return float(sum(els.size * op.eta.size * kernels.point_flops(op)
-                     for op, _, els, _ in model._families()))
+    """Flops of the layer kernels per evaluation (force + tangent), as executed.
+
+    The packed kernel's GEMMs (``kernels.point_flops``) or, for the layers the sum-factorised
+    kernel evaluates (core levels 2-4), its two stages (``kernels.layer_flops``).
+    """
+    return float(sum(els.size * kernels.layer_flops(op) for op, _, els, _ in model._families()))
 
 
 def deformed_state(model):
@@ -204,8 +207,8 @@ def fig5_speed(repeat, with_2d):
         "shipped (`core = \"auto\"`: core levels chosen and checked by up to three passes of "
         "the path).",
         "",
-        f"Machine shared with other jobs, 2 cores: {before} before, {after} after. "
-        "Times are best of the runs; on an idle machine expect them lower.",
+        f"2 cores: {before} before, {after} after (this benchmark's own runs included; "
+        "other jobs, if any, inflate the times). Times are best of the runs.",
         "",
         "| run | solve wall (s) | whole process (s) | steps | Newton its | λ(−15 mm) | "
         "negative pivots seen |",
@@ -264,8 +267,8 @@ def write_iterations(rows, reference, peak, before, after):
         "counted), the factorisation and the solves, exactly as executed. Peak: this machine's "
         f"measured single-thread DGEMM rate, {peak / 1e9:.1f} GF/s.",
         "",
-        f"Machine shared with other jobs: {before} at the start, {after} at the end "
-        "(2 cores; the timings are inflated by the load).",
+        f"2 cores: {before} at the start, {after} at the end (this benchmark's own work "
+        "included; other jobs, if any, inflate the times).",
         "",
         "The factorisation's backend: `envelope` (the pivot-free LDLᵀ, half-band of its "
         "structure) or `superlu` — the stated fallback, taken when the LDLᵀ is untrustworthy "
