@@ -350,6 +350,21 @@ def _numerical_first(env, rowptr, first, n):  # pragma: no cover - compiled
     return lo
 
 
+@njit
+def _record_pivot(d, finite, dmin, ldmax, negative):  # pragma: no cover - compiled
+    """Pivot d into the acceptance statistics: all finite, min |d|, max |(L D)|, count of d < 0."""
+    ad = abs(d)
+    if not (ad <= 1.0e308):  # inf or NaN
+        finite = False
+    if ad < dmin:
+        dmin = ad
+    if ad > ldmax:
+        ldmax = ad
+    if d < 0.0:
+        negative += 1
+    return finite, dmin, ldmax, negative
+
+
 @njit(reassociate=True)
 def _ldlt(env, rowptr, first, lo, n, w):  # pragma: no cover - compiled
     """In-place envelope LDLᵀ (row-by-row Crout): L below the diagonal, D on it.
@@ -388,15 +403,7 @@ def _ldlt(env, rowptr, first, lo, n, w):  # pragma: no cover - compiled
             if al > lmax:
                 lmax = al
         env[ri + i] = d
-        ad = abs(d)
-        if not (ad <= 1.0e308):  # inf or NaN
-            finite = False
-        if ad < dmin:
-            dmin = ad
-        if ad > ldmax:
-            ldmax = ad
-        if d < 0.0:
-            negative += 1
+        finite, dmin, ldmax, negative = _record_pivot(d, finite, dmin, ldmax, negative)
     if not finite:
         dmin = np.nan
     return negative, dmin, ldmax, lmax
@@ -455,15 +462,7 @@ def _column_ldlt(env, colptr, last, n):  # pragma: no cover - compiled
         w = 4 if j + 4 <= n else 1
         for p in range(j, j + w):  # the panel's columns, each updating the panel's later ones
             d = env[colptr[p]]
-            ad = abs(d)
-            if not (ad <= 1.0e308):
-                finite = False
-            if ad < dmin:
-                dmin = ad
-            if ad > ldmax:
-                ldmax = ad
-            if d < 0.0:
-                negative += 1
+            finite, dmin, ldmax, negative = _record_pivot(d, finite, dmin, ldmax, negative)
             a, b = _scale_column(env, colptr[p], last[p] - p, d)
             ldmax = a if a > ldmax else ldmax
             lmax = b if b > lmax else lmax
