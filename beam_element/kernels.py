@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -85,44 +86,28 @@ class KernelOperators:
     stiffness: np.ndarray  # (3, 3)
     thickness: float
 
-    # The packed products (below) are formed on first use: a layer that the sum-factorised
-    # kernel evaluates (core levels 2-4) never needs them (level 3: 4.5 MB per layer).
-    @property
-    def G(self) -> int:
-        """Number of points."""
-        return self.weight.size
-
     @cached_property
-    def Quu(self) -> np.ndarray:
-        """(3G, n_u (n_u + 1) / 2), rows (00 | 11 | 01) per point."""
-        return self._packed[0][0]
+    def packed(self) -> PackedProducts:
+        """The packed products Q, formed on first use.
 
-    @cached_property
-    def pu(self) -> np.ndarray:
-        """(2, n_u (n_u + 1) / 2): (a, b) of each packed uu pair, a ≤ b."""
-        return self._packed[0][1]
-
-    @cached_property
-    def Qww(self) -> np.ndarray:
-        """(3G, n_w (n_w + 1) / 2), rows (22 | 33 | 23)."""
-        return self._packed[1][0]
-
-    @cached_property
-    def pw(self) -> np.ndarray:
-        """(2, n_w (n_w + 1) / 2)."""
-        return self._packed[1][1]
-
-    @cached_property
-    def Quw(self) -> np.ndarray:
-        """(4G, n_u n_w), rows (02 | 03 | 12 | 13)."""
-        return self._packed[2][0]
-
-    @cached_property
-    def _packed(self) -> tuple:
-        G = self.G
+        A layer the sum-factorised kernel evaluates (core levels 2-4) never needs them (level 3:
+        4.5 MB per layer).
+        """
+        G = self.weight.size
         N0, N1, M0, M1 = self.Nu[:G], self.Nu[G:], self.Mw[:G], self.Mw[G:]
-        return (_packed_products(N0, N1, N0, N1, True), _packed_products(M0, M1, M0, M1, True),
-                _packed_products(N0, N1, M0, M1, False))
+        (Quu, pu), (Qww, pw) = (_packed_products(N0, N1, N0, N1, True),
+                                _packed_products(M0, M1, M0, M1, True))
+        return PackedProducts(Quu, Qww, _packed_products(N0, N1, M0, M1, False)[0], pu, pw)
+
+
+class PackedProducts(NamedTuple):
+    """Rows of Q for the three field pairs (:class:`KernelOperators`) and the packed pairs."""
+
+    Quu: np.ndarray  # (3G, n_u (n_u + 1) / 2), rows (00 | 11 | 01) per point
+    Qww: np.ndarray  # (3G, n_w (n_w + 1) / 2), rows (22 | 33 | 23)
+    Quw: np.ndarray  # (4G, n_u n_w), rows (02 | 03 | 12 | 13)
+    pu: np.ndarray  # (2, n_u (n_u + 1) / 2): (a, b) of each packed uu pair, a ≤ b
+    pw: np.ndarray  # (2, n_w (n_w + 1) / 2)
 
 
 def supports(op: LayerOperators) -> bool:
@@ -459,8 +444,9 @@ def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
         wbar = averaging_weights(op)
         if wbar is None:
             raise ValueError(f"{op.name}: membrane_average needs a tensor rule and symmetric C")
-        averaged_kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww,
-                        k.Quw, k.pu, k.pw, k.ucols, k.wcols, k.x_slope, k.weight, wbar,
+        q = k.packed
+        averaged_kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, q.Quu, q.Qww,
+                        q.Quw, q.pu, q.pw, k.ucols, k.wcols, k.x_slope, k.weight, wbar,
                         k.stiffness, k.thickness, f, want_k, K_out, slots, signs, data)
         return f
     if uses_sum_factorisation(op):
@@ -471,8 +457,9 @@ def _run(op, u_l, lengths, width, want_k, K_out, slots, signs, data):
                         k.x_slope, k.weight, k.stiffness, k.thickness, f, want_k, K_out, slots,
                         signs, data)
         return f
-    _kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, k.Quu, k.Qww, k.Quw, k.pu,
-            k.pw, k.ucols, k.wcols, k.x_slope, k.weight, k.stiffness, k.thickness, f,
+    q = k.packed
+    _kernel(u_l, lengths, float(width), k.NuT, k.MwT, k.Nu, k.Mw, q.Quu, q.Qww, q.Quw, q.pu,
+            q.pw, k.ucols, k.wcols, k.x_slope, k.weight, k.stiffness, k.thickness, f,
             want_k, K_out, slots, signs, data)
     return f
 
