@@ -127,15 +127,8 @@ def _storage_map(indptr, indices, order, first, last, rowptr, colptr,
     inv = np.empty(n, dtype=np.int64)
     for k in range(n):
         inv[order[k]] = k
-    count = 0
-    for r in range(n):
-        i = inv[r]
-        for t in range(indptr[r], indptr[r + 1]):
-            j = inv[indices[t]]
-            if (j >= i) if columns else (j <= i):
-                count += 1
-    slots = np.empty(count, dtype=np.int64)
-    positions = np.empty(count, dtype=np.int64)
+    slots = np.empty(indices.size, dtype=np.int64)
+    positions = np.empty(indices.size, dtype=np.int64)
     c = 0
     for r in range(n):
         i = inv[r]
@@ -149,7 +142,7 @@ def _storage_map(indptr, indices, order, first, last, rowptr, colptr,
                 slots[c] = t
                 positions[c] = rowptr[i] + (j - first[i]) if j >= first[i] else -1
                 c += 1
-    return slots, positions
+    return slots[:c].copy(), positions[:c].copy()
 
 
 @dataclass(frozen=True)
