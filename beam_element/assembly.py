@@ -47,13 +47,12 @@ class ReducedPattern:
             B, m = f.shape
             kernels = _pattern_kernels()
             if kernels is None:
-                slots = _slots_sorted(f, self.indptr, self.indices)
-            else:
-                slots = np.empty((B, m, m), dtype=np.int64)
-                kernels[1](f, self.indptr.astype(np.int64), self.indices.astype(np.int64),
-                           self.n, slots)
-            sg = self.sign[i].astype(np.int8)
-            self._slots[i] = (slots.astype(np.int32), sg[:, :, None] * sg[:, None, :])
+                slots = _slots_sorted(f, self.indptr, self.indices).astype(np.int32)
+            else:  # written as int32 straight from the int32 pattern: no copies
+                slots = np.empty((B, m, m), dtype=np.int32)
+                kernels[1](f, self.indptr, self.indices, self.n, slots)
+            sg = self.sign[i]
+            self._slots[i] = (slots, sg[:, :, None] * sg[:, None, :])
         return self._slots[i]
 
     @property

@@ -285,7 +285,8 @@ class BeamModel:
             del known[4:]
         fac = factorize_envelope(K, structure)
         widened = getattr(fac, "structure", structure)
-        if widened is not structure and widened.matches(K):
+        if (widened is not structure and widened.matches(K)
+                and widened.ordering == structure.ordering):  # not the natural-order retry's
             known[known.index(structure)] = widened
         return fac
 
@@ -426,7 +427,7 @@ class BeamModel:
                 sign = np.where(free >= 0, self.dof_map.sign[dofs10], 0).astype(np.int8)
                 if kernels.scatter_compact(free, sign, np.ascontiguousarray(K10),
                                            pattern.indptr, pattern.indices, data):
-                    self._grow_pattern(dofs10)
+                    self._grow_pattern(_segments_around(pairs, cols))
                     return self._compiled_forces(u_full, kernels)
                 continue
             f, K, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
@@ -513,6 +514,26 @@ class BeamModel:
     def penetration_bound(self) -> float:
         """Allowed penetration (mm): PENETRATION_BOUND × the thinner face."""
         return PENETRATION_BOUND * min(self.face_thickness.values())
+
+
+def _segments_around(pairs: ContactPairs, cols: np.ndarray) -> np.ndarray:
+    """Full DOFs (3m, 10) of each closest-point pair's chosen segment and its two neighbours.
+
+    ``cols`` are the chosen segment's 10 columns in ``support_dofs`` (:func:`compact_response`):
+    the face node's two, then core nodes ``seg`` and ``seg + 1``. A projection slides from
+    segment to segment, so the pattern grows by the neighbours too: the next slide finds its
+    couplings in place instead of rebuilding the pattern, slot maps and factorisation
+    structure (fig. 5 with auto levels: 22 rebuilds). A neighbour beyond the searched stretch
+    is the segment itself (duplicate rows are dropped by :meth:`BeamModel._grow_pattern`).
+    """
+    segments = (pairs.support_dofs.shape[1] - 2) // 4 - 1
+    seg = (cols[:, 2] - 2) // 4
+    out = []
+    for shift in (-1, 0, 1):
+        step = 4 * (np.clip(seg + shift, 0, segments - 1) - seg)
+        out.append(np.take_along_axis(pairs.support_dofs,
+                                      np.where(cols >= 2, cols + step[:, None], cols), axis=1))
+    return np.concatenate(out)
 
 
 def _seed_dofs(pairs: ContactPairs) -> np.ndarray:

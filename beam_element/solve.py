@@ -116,9 +116,26 @@ def linear_solution(model: BeamModel, load_factor: float) -> tuple[np.ndarray, i
     The tangent at u = 0 plus the penalty on the linearised gap of the pairs in contact; the
     active set is iterated to a fixed point. Returns the free DOFs and the number of passes.
     """
+    u, passes, _ = _active_set_solution(model, load_factor)
+    return u, passes
+
+
+def _active_set_solution(
+    model: BeamModel, load_factor: float, start: list[np.ndarray] | None = None
+) -> tuple[np.ndarray, int, list[np.ndarray]]:
+    """:func:`linear_solution` from the active set ``start`` (default: every pair open).
+
+    Also returns the active set it settled on. The start changes the passes, not the answer:
+    a fixed point is a stationary point of ½uᵀK₀u − fᵀu + ½ε Σ A ⟨−g_lin⟩², strictly convex
+    for a positive definite K₀, so there is one (pairs with a gap exactly zero aside). The auto
+    core levels solve the same scene at several levels with the same pairs, and each solve
+    starts from the last one's set.
+    """
     K0 = model.tangent(np.zeros(model.size))
     f = load_factor * model.f_ref
     active = [np.zeros(p.size, dtype=bool) for p in model.pairs]
+    if start is not None and [a.shape for a in start] == [a.shape for a in active]:
+        active = [np.array(a, dtype=bool) for a in start]
     for passes in range(1, MAX_ACTIVE_SET_PASSES + 1):
         fac = model.factorize(K0 + _linear_contact_matrix(model, active))
         u = np.asarray(fac.solve(f), dtype=float)
@@ -128,7 +145,7 @@ def linear_solution(model: BeamModel, load_factor: float) -> tuple[np.ndarray, i
             v = u_full[pairs.dofs]
             new.append(NORMAL_SIGN[pairs.interface] * (v[:, 1] - v[:, 3]) < 0.0)
         if all(np.array_equal(a, b) for a, b in zip(active, new, strict=True)):
-            return u, passes
+            return u, passes, active
         active = new
     raise RuntimeError(
         f"linear contact active set did not settle in {MAX_ACTIVE_SET_PASSES} passes"
@@ -387,7 +404,14 @@ def choose_core_levels(scene: object, elements: int | None, options: dict) -> Le
 
     base = build(floor)
     sign = _load_sign(base, scene)
-    choice = auto_levels(build, lambda m: linear_solution(m, sign)[0], mesh.n_elements,
+    settled: list[list[np.ndarray]] = []  # the last linear solve's active set
+
+    def solve_linear(model: BeamModel) -> np.ndarray:
+        u, _, active = _active_set_solution(model, sign, settled[-1] if settled else None)
+        settled[:] = [active]
+        return u
+
+    choice = auto_levels(build, solve_linear, mesh.n_elements,
                          float(getattr(bm, "tolerance", 0.01)),
                          int(getattr(bm, "max_core_level", 3)), probe=scene.analysis.until_probe)
     # no level change next to a debond tip: it biases G (docs/fracture.md)

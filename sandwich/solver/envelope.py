@@ -16,9 +16,12 @@ for — symmetric, without pivoting, so ``K = L D Lᵀ`` and, by Sylvester's law
 number of negative entries of D is the number of negative eigenvalues of K (what the path
 follower needs for bifurcations). It is trusted under the same tests as there: every pivot
 finite and above ``singular_rtol · n · max|K|`` and the factors' growth below
-:data:`~sandwich.solver.sparse.GROWTH_LIMIT`. Otherwise :func:`factorize_envelope` falls back
-to :class:`~sandwich.solver.sparse.SparseFactorization` (SuperLU; a pivoting LU with unknown
-inertia when even that fails). LAPACK has no banded LDLᵀ with pivoting for indefinite matrices:
+:data:`~sandwich.solver.sparse.GROWTH_LIMIT`. The pivots depend on the order: when the tests
+refuse the LDLᵀ in reverse Cuthill-McKee order, :func:`factorize_envelope` tries the natural
+order (the one SuperLU's pivot-free LDLᵀ uses) in its own envelope; when that is refused too it
+falls back to SuperLU's pivoting LU (:class:`~sandwich.solver.sparse.SparseFactorization`,
+inertia unknown) — not to SuperLU's pivot-free LDLᵀ, the same factorisation under the same
+tests. LAPACK has no banded LDLᵀ with pivoting for indefinite matrices:
 ``dpbtrf`` (banded Cholesky) fails on every state past the first bifurcation and ``dgbtrf``
 (banded LU with row interchanges) gives only the sign of det K, not the count of negative
 eigenvalues (docs/beam_speed.md).
@@ -193,15 +196,28 @@ class EnvelopeStructure:
                 and (K.indices is self.indices or np.array_equal(K.indices, self.indices))
                 and (K.indptr is self.indptr or np.array_equal(K.indptr, self.indptr)))
 
+    def natural_variant(self, K: sp.csr_matrix) -> EnvelopeStructure:
+        """The natural-order numeric structure of ``K``'s pattern, built once and kept.
+
+        :func:`factorize_envelope`'s second try when the LDLᵀ in this (RCM) order is refused.
+        """
+        natural = self.__dict__.get("_natural")
+        if natural is None or not natural.matches(K):
+            natural = EnvelopeStructure.of(K, numeric=True, ordering="natural")
+            self.__dict__["_natural"] = natural
+        return natural
+
     @classmethod
     def of(cls, K: sp.spmatrix, *, numeric: bool = False,
-           widen: EnvelopeStructure | None = None) -> EnvelopeStructure:
+           widen: EnvelopeStructure | None = None,
+           ordering: str | None = None) -> EnvelopeStructure:
         """Structure for the pattern of ``K`` (CSR, canonical: sorted, no duplicates).
 
         ``numeric``: the envelope of K's non-zero *values* (its explicit zeros left out; the
         diagonal always in), still mapped from K's whole CSR pattern: a pattern entry outside
         it must be zero when a matrix is loaded, else :func:`factorize_envelope` widens the
         structure (``widen``: the union with that structure's envelope, in its ordering).
+        ``ordering``: ``"natural"`` to take that order without comparing it with RCM's.
         """
         from scipy.sparse.csgraph import reverse_cuthill_mckee
 
@@ -215,7 +231,7 @@ class EnvelopeStructure:
         candidates = {"natural": np.arange(n)}
         if widen is not None:
             candidates = {widen.ordering: widen.order}
-        elif n > 1:
+        elif n > 1 and ordering != "natural":
             candidates["rcm"] = np.asarray(
                 reverse_cuthill_mckee(sp.csr_matrix((np.ones(p_indices.size), p_indices,
                                                      p_indptr), shape=K.shape),
@@ -638,9 +654,32 @@ def factorize_envelope(
     if structure is None or not structure.matches(A):  # a match has canonical indices
         A = _canonical_csr(A)
         structure = EnvelopeStructure.of(A)
-    n = A.shape[0]
-    if n == 0:
+    if A.shape[0] == 0:
         return SparseFactorization(A)
+    fac = _trusted_ldlt(A, structure, singular_rtol)
+    if fac is None and structure.ordering != "natural":
+        # The pivot-free LDLᵀ depends on the order: where reverse Cuthill-McKee's is refused
+        # the natural one is often trusted (fig. 5, 3840 elements, a compressed debonded face).
+        natural = structure.natural_variant(A)
+        fac = _trusted_ldlt(A, natural, singular_rtol)
+        if fac is not None:
+            structure.__dict__["_natural"] = fac.structure  # widened, if it was
+    if fac is None:
+        # Refused in the natural order: SuperLU's pivot-free LDLᵀ is that same factorisation
+        # under the same tests, so straight to its pivoting LU (inertia unknown).
+        return SparseFactorization(A, singular_rtol, pivot_free=False)
+    return fac
+
+
+def _trusted_ldlt(
+    A: sp.csr_matrix, structure: EnvelopeStructure, singular_rtol: float
+) -> EnvelopeFactorization | None:
+    """The envelope LDLᵀ of ``A`` in ``structure``, or None when its tests refuse it.
+
+    A numeric structure that meets a coupling outside it is widened once (the factorisation's
+    ``structure`` is then the widened one).
+    """
+    n = A.shape[0]
     env, kmax, outside = _load(A.data, structure.slots, structure.positions, structure.size)
     if outside:  # a numeric structure met a coupling its envelope lacks: widen it, once
         structure = EnvelopeStructure.of(A, numeric=True, widen=structure)
@@ -661,5 +700,5 @@ def factorize_envelope(
     growth = max(ldmax / kmax, lmax)
     if (not np.isfinite(dmin) or dmin <= singular_rtol * n * kmax
             or not np.isfinite(growth) or growth > GROWTH_LIMIT):
-        return SparseFactorization(A, singular_rtol)
+        return None
     return EnvelopeFactorization(env, structure, int(negative), lo)

@@ -53,6 +53,9 @@ class SparseFactorization:
     singular_rtol
         A pivot of the (pivoting) LU with ``|u_ii| <= singular_rtol * n * max|K_ij|`` is treated
         as zero, i.e. ``K`` is declared singular.
+    pivot_free
+        False: straight to the pivoting LU, for a caller that has already seen the pivot-free
+        LDLᵀ in the natural order refused (:func:`sandwich.solver.envelope.factorize_envelope`).
 
     Attributes
     ----------
@@ -66,7 +69,8 @@ class SparseFactorization:
         If ``K`` is singular to working precision, or has non-finite entries.
     """
 
-    def __init__(self, K: object, singular_rtol: float = float(np.finfo(float).eps)) -> None:
+    def __init__(self, K: object, singular_rtol: float = float(np.finfo(float).eps),
+                 pivot_free: bool = True) -> None:
         A = _as_csc(K)
         self.size = A.shape[0]
         if A.nnz and not np.all(np.isfinite(A.data)):
@@ -81,7 +85,7 @@ class SparseFactorization:
             raise SingularTangentError("tangent is the zero matrix")
         self._negative = None
         self.pivoted = True
-        lu = self._ldlt(A, kmax, singular_rtol)
+        lu = self._ldlt(A, kmax, singular_rtol) if pivot_free else None
         if lu is not None:
             self._negative = int(np.count_nonzero(lu.U.diagonal() < 0.0))
             self.pivoted = False

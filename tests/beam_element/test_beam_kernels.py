@@ -261,6 +261,31 @@ def test_compiled_pattern_grows_to_the_segments_projections_meet():
     assert model.pattern_growths == grown
 
 
+def test_pattern_growth_takes_the_neighbouring_segments():
+    """A projection that slides one segment on finds its couplings in place: the growth took
+    the met segment's neighbours (mutation: growing by the met segments only grows again at
+    the second slide), and force and tangent still equal the NumPy path's."""
+    scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
+    model = build_model(scene, contact_search="closest-point", contact_reach=9.0,
+                        grading="graded")
+    u = _contact_state(model, np.random.default_rng(5))
+    pairs = model.pairs[0]
+    face_u = model.dof_map.free[pairs.dofs[:, 0]]
+    h = np.diff(model.mesh.x).min()
+    for slide, growths in ((1.2 * h, 1), (2.2 * h, 1)):
+        v = u.copy()
+        v[face_u] += slide
+        model._cache = None
+        f1, K1 = model.internal_force(v), model.tangent(v)
+        assert model.pattern_growths == growths
+        assert model.contact_summary(v)["top"].active > 0
+        model.use_kernels = False
+        f0, K0 = model.internal_force(v), model.tangent(v)
+        model.use_kernels = True
+        assert np.linalg.norm(f1 - f0) <= 1e-13 * np.linalg.norm(f0)
+        assert abs(K1 - K0).max() <= 1e-13 * abs(K0).max()
+
+
 def test_compiled_force_carries_its_tangent():
     """One pass: the tangent at the last force's u is not evaluated again."""
     model = build_model(sandwich_scene(length=60.0, elements=8))

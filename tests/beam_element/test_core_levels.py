@@ -205,3 +205,25 @@ def test_field_grid_shows_the_sublayers_and_their_levels():
     # the cells of element 5 (level 3) carry level 3: columns 10, 11 of every core row
     per_row = 12 * 2
     assert np.all(f.core_level[:core_cells.sum()].reshape(-1, per_row)[:, 10:12] == 3)
+
+
+def test_linear_active_set_from_another_start_ends_at_the_same_fixed_point():
+    """The unilateral linear step minimises a strictly convex energy, so the active-set
+    iteration has one fixed point whatever it starts from: every pair open (the default),
+    every pair closed, or another level's settled set (what the auto levels hand on) give the
+    same set and the same solution, the last in one pass."""
+    from beam_element.solve import _active_set_solution
+
+    scene = _debonded_bend()
+    m1 = build_model(scene, elements=24, core_level=1)
+    m3 = build_model(scene, elements=24, core_level=3)
+    _, _, settled_1 = _active_set_solution(m1, 1.0)
+    u3, passes_3, settled_3 = _active_set_solution(m3, 1.0)
+    closed = int(settled_3[0].sum())
+    assert passes_3 >= 3 and 0 < closed < settled_3[0].size  # a real active-set problem
+    for start in (settled_1, [np.ones_like(a) for a in settled_3]):
+        u, passes, settled = _active_set_solution(m3, 1.0, start)
+        assert all(np.array_equal(a, b) for a, b in zip(settled, settled_3, strict=True))
+        assert np.linalg.norm(u - u3) <= 1e-14 * np.linalg.norm(u3)
+        assert passes < passes_3
+    assert _active_set_solution(m3, 1.0, settled_1)[1] == 1

@@ -168,6 +168,58 @@ def test_zero_pivot_falls_back_to_superlu():
     assert np.allclose(A @ fac.solve(np.array([1.0, 2.0, 3.0])), [1.0, 2.0, 3.0])
 
 
+def _chain_with_zero_ends(rng, n):
+    """A scrambled path graph whose two end rows have a zero diagonal, each end numbered after
+    its neighbour: reverse Cuthill-McKee starts at an end (a zero first pivot), the natural
+    order eliminates the neighbour first (the end's pivot is then −a²/d ≠ 0)."""
+    path = rng.permutation(n)
+    for a, b in ((0, 1), (-1, -2)):
+        if path[a] < path[b]:
+            path[[a, b]] = path[[b, a]]
+    off = sp.csr_matrix((rng.uniform(1, 2, n - 1), (path[:-1], path[1:])), shape=(n, n))
+    d = rng.choice([-1.0, 1.0], n) * rng.uniform(3, 4, n)
+    d[path[[0, -1]]] = 0.0
+    A = (off + off.T + sp.diags(d)).tocsr()
+    A.sort_indices()
+    return A
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_refused_in_rcm_order_is_factorised_in_the_natural_order(seed, monkeypatch):
+    """No SuperLU: the natural-order envelope LDLᵀ, with the inertia of the dense eigenvalues
+    and solves to round-off; its structure is built once."""
+    A = _chain_with_zero_ends(np.random.default_rng(seed), 40)
+    s = EnvelopeStructure.of(A)
+    assert s.ordering == "rcm" and A[s.order[0], s.order[0]] == 0.0
+
+    def no_superlu(*args, **kwargs):
+        raise AssertionError("SuperLU called")
+
+    monkeypatch.setattr(SparseFactorization, "__init__", no_superlu)
+    fac = factorize_envelope(A, s)
+    assert isinstance(fac, EnvelopeFactorization) and fac.structure.ordering == "natural"
+    eig = np.linalg.eigvalsh(A.toarray())
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+    b = np.random.default_rng(seed).normal(size=40)
+    cond = np.abs(eig).max() / np.abs(eig).min()
+    assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-13 * cond * np.linalg.norm(b)
+    assert factorize_envelope(A, s).structure is fac.structure
+
+
+def test_refused_in_the_natural_order_goes_straight_to_the_pivoting_lu(monkeypatch):
+    """SuperLU's pivot-free LDLᵀ is the natural order's, under the same tests: not tried again."""
+
+    def no_pivot_free(*args, **kwargs):
+        raise AssertionError("the pivot-free LDLᵀ was retried")
+
+    monkeypatch.setattr(SparseFactorization, "_ldlt", staticmethod(no_pivot_free))
+    A = sp.csr_matrix(np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 2.0]]))
+    fac = factorize_envelope(A)
+    assert isinstance(fac, SparseFactorization) and fac.pivoted
+    assert fac.negative_pivots is None
+    assert np.allclose(A @ fac.solve(np.array([1.0, 2.0, 3.0])), [1.0, 2.0, 3.0])
+
+
 def test_bad_matrices_are_refused():
     with pytest.raises(SingularTangentError):
         factorize_envelope(sp.csr_matrix(np.array([[1.0, np.nan], [np.nan, 1.0]])))
