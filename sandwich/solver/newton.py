@@ -161,8 +161,7 @@ def newton_correct(
                 break
             try:
                 fac = system.factorize(system.tangent(u))
-                du_r = np.asarray(fac.solve(-res), dtype=float)
-                du_f = np.asarray(fac.solve(f_ref), dtype=float)
+                du_r, du_f = _solve_both(fac, -res, f_ref)
             except RECOVERABLE_ERRORS as exc:
                 return fail(f"singular tangent: {exc}", it)
             dlam = constraint.delta_lambda(du_r, du_f, u, lam, u - u0, lam - lam0)
@@ -178,6 +177,18 @@ def newton_correct(
         f"no convergence in {settings.max_iterations} iterations (residual {r_norm:.3e})",
         settings.max_iterations,
     )
+
+
+def _solve_both(fac: object, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """K⁻¹a and K⁻¹b.
+
+    One call with both as columns where the factorisation takes them (``solves_columns``: one
+    sweep of the factors for the two), else one call each.
+    """
+    if getattr(fac, "solves_columns", False):
+        x = np.asarray(fac.solve(np.column_stack((a, b))), dtype=float)
+        return x[:, 0], x[:, 1]
+    return np.asarray(fac.solve(a), dtype=float), np.asarray(fac.solve(b), dtype=float)
 
 
 def _roundoff(system: DiscreteSystem, u: np.ndarray) -> float:

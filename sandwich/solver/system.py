@@ -27,7 +27,12 @@ import numpy as np
 
 
 class Factorization(Protocol):
-    """A factorised tangent: solves with it, and its inertia if the backend knows it."""
+    """A factorised tangent: solves with it, and its inertia if the backend knows it.
+
+    A factorisation whose ``solve`` also takes an (n, m) array of right-hand sides may say so
+    with a true ``solves_columns`` attribute: the corrector then asks for its two solves in
+    one call (:mod:`sandwich.solver.newton`).
+    """
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Return ``K⁻¹ b``."""

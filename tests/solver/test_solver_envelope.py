@@ -44,11 +44,12 @@ def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeyp
     fac = factorize_envelope(A)
     assert isinstance(fac, EnvelopeFactorization) and fac.structure.storage == storage
     assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
-    b = rng.normal(size=(n, 2))
+    b = rng.normal(size=(n, 3))  # columns in a pair and one alone
     x = fac.solve(b)
     cond = np.abs(eig).max() / np.abs(eig).min()
     assert np.linalg.norm(A @ x - b) <= 1e-12 * cond * np.linalg.norm(b)
-    assert np.allclose(fac.solve(b[:, 0]), x[:, 0], rtol=0, atol=1e-14 * np.abs(x).max())
+    for c in range(3):
+        assert np.allclose(fac.solve(b[:, c]), x[:, c], rtol=0, atol=1e-14 * np.abs(x).max())
 
 
 def test_explicit_zeros_in_wide_rows_are_skipped_with_the_same_answer(monkeypatch):
