@@ -537,13 +537,12 @@ def _column_solve(env, colptr, last, n, order, rhs, x):  # pragma: no cover - co
     y0 = np.empty(n)
     y1 = np.empty(n)
     for c in range(0, m, 2):
-        two = c + 1 < m
-        if not two:
+        if c + 1 == m:  # an odd one out
             _column_solve_one(env, colptr, last, n, order, rhs, x, c, y0)
             break
         for i in range(n):
             y0[i] = rhs[order[i], c]
-            y1[i] = rhs[order[i], c + 1] if two else 0.0
+            y1[i] = rhs[order[i], c + 1]
         for j in range(n):  # L y = P rhs, column by column
             cj = colptr[j]
             k = last[j] - j
