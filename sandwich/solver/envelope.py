@@ -204,8 +204,22 @@ class EnvelopeStructure:
         natural = self.__dict__.get("_natural")
         if natural is None or not natural.matches(K):
             natural = EnvelopeStructure.of(K, numeric=True, ordering="natural")
-            self.__dict__["_natural"] = natural
+            self.keep_natural(natural, preferred=False)
         return natural
+
+    def keep_natural(self, natural: EnvelopeStructure, preferred: bool) -> None:
+        """Keep ``natural`` as this structure's natural-order variant (widened, if it was).
+
+        ``preferred``: whether the natural order is to be tried first next time (it was trusted
+        where this order was refused; a later refusal in it hands the first try back).
+        """
+        self.__dict__["_natural"] = natural
+        self.__dict__["_natural_first"] = preferred
+
+    @property
+    def natural_first(self) -> bool:
+        """Whether :func:`factorize_envelope` tries the natural-order variant first."""
+        return bool(self.__dict__.get("_natural_first", False))
 
     @classmethod
     def of(cls, K: sp.spmatrix, *, numeric: bool = False,
@@ -711,14 +725,22 @@ def factorize_envelope(
         structure = EnvelopeStructure.of(A)
     if A.shape[0] == 0:
         return SparseFactorization(A)
+    tried_natural = structure.natural_first
+    if tried_natural:
+        # The last tangent refused in this (RCM) order was trusted in the natural one: the
+        # next are tried there first (the path's state changes slowly), not refused again.
+        fac = _trusted_ldlt(A, structure.natural_variant(A), singular_rtol)
+        if fac is not None:
+            structure.keep_natural(fac.structure, preferred=True)
+            return fac
+        structure.keep_natural(structure.natural_variant(A), preferred=False)
     fac = _trusted_ldlt(A, structure, singular_rtol)
-    if fac is None and structure.ordering != "natural":
+    if fac is None and structure.ordering != "natural" and not tried_natural:
         # The pivot-free LDLᵀ depends on the order: where reverse Cuthill-McKee's is refused
         # the natural one is often trusted (fig. 5, 3840 elements, a compressed debonded face).
-        natural = structure.natural_variant(A)
-        fac = _trusted_ldlt(A, natural, singular_rtol)
+        fac = _trusted_ldlt(A, structure.natural_variant(A), singular_rtol)
         if fac is not None:
-            structure.__dict__["_natural"] = fac.structure  # widened, if it was
+            structure.keep_natural(fac.structure, preferred=True)
     if fac is None:
         # Refused in the natural order: SuperLU's pivot-free LDLᵀ is that same factorisation
         # under the same tests, so straight to its pivoting LU (inertia unknown).

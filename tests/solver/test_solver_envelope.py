@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from sandwich.solver import SingularTangentError, SparseFactorization, jit
+from sandwich.solver import SingularTangentError, SparseFactorization, envelope, jit
 from sandwich.solver.envelope import (
     EnvelopeFactorization,
     EnvelopeStructure,
@@ -205,6 +205,58 @@ def test_refused_in_rcm_order_is_factorised_in_the_natural_order(seed, monkeypat
     cond = np.abs(eig).max() / np.abs(eig).min()
     assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-13 * cond * np.linalg.norm(b)
     assert factorize_envelope(A, s).structure is fac.structure
+
+
+def _orders_tried(monkeypatch):
+    """The orderings :func:`factorize_envelope` tries its LDLᵀ in, recorded as it goes."""
+    tried = []
+    trusted = envelope._trusted_ldlt
+
+    def record(A, structure, rtol):
+        tried.append(structure.ordering)
+        return trusted(A, structure, rtol)
+
+    monkeypatch.setattr(envelope, "_trusted_ldlt", record)
+    return tried
+
+
+def test_the_order_trusted_after_a_refusal_is_tried_first(monkeypatch):
+    """After RCM's refusal and the natural order's success, the next tangent of the pattern
+    goes to the natural order first (not refused again in RCM), with the same inertia."""
+    A = _chain_with_zero_ends(np.random.default_rng(1), 40)
+    s = EnvelopeStructure.of(A)
+    tried = _orders_tried(monkeypatch)
+    first = factorize_envelope(A, s)
+    assert tried == ["rcm", "natural"] and s.natural_first
+    tried.clear()
+    again = factorize_envelope(A * 2.0, s)
+    assert tried == ["natural"] and again.structure is first.structure
+    assert again.negative_pivots == first.negative_pivots
+
+
+def test_a_refusal_in_the_preferred_natural_order_hands_the_first_try_back(monkeypatch):
+    """A zero first pivot in the natural order (row 0 mid-chain, RCM starts at an end): with
+    the natural order preferred, it is tried, refused, and RCM's LDLᵀ is taken and kept first."""
+    rng = np.random.default_rng(2)
+    n = 30
+    path = rng.permutation(n)
+    while path[0] == 0 or path[-1] == 0:
+        path = rng.permutation(n)
+    off = sp.csr_matrix((rng.uniform(1, 2, n - 1), (path[:-1], path[1:])), shape=(n, n))
+    d = rng.uniform(5, 6, n)
+    A = (off + off.T + sp.diags(d)).tocsr()
+    A.sort_indices()
+    A.data[A.indptr[0] + np.flatnonzero(A.indices[A.indptr[0]:A.indptr[1]] == 0)] = 0.0
+    s = EnvelopeStructure.of(A)
+    assert s.ordering == "rcm" and s.order[0] != 0
+    s.keep_natural(s.natural_variant(A), preferred=True)
+    tried = _orders_tried(monkeypatch)
+    fac = factorize_envelope(A, s)
+    assert tried == ["natural", "rcm"]
+    assert isinstance(fac, EnvelopeFactorization) and fac.structure.ordering == "rcm"
+    assert not s.natural_first
+    eig = np.linalg.eigvalsh(A.toarray())
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
 
 
 def test_refused_in_the_natural_order_goes_straight_to_the_pivoting_lu(monkeypatch):
