@@ -39,6 +39,7 @@ from beam_element.model import BeamModel  # noqa: E402
 from beam_element.solve import scene_model_options  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 from sandwich.solver.envelope import EnvelopeFactorization  # noqa: E402
+from sandwich.solver.jit import kernel_backend  # noqa: E402
 from sandwich.solver.newton import _solve_both  # noqa: E402
 from sandwich.solver.sparse import SparseFactorization  # noqa: E402
 
@@ -167,13 +168,18 @@ def in_process_path(reference: bool, repeat: int, elements: int | None = None,
     return best, result
 
 
-def cli_run(model: str, repeat: int, auto: bool = False, level: str | None = None):
+def cli_run(model: str, repeat: int, auto: bool = False, level: str | None = None,
+            kernels: str | None = None):
     """``sandwich solve`` as a user runs it: whole-process time and summary.json wall_seconds.
 
     The beam runs a copy of the scene with ``[beam_model] core = 1`` (the paper's core), or
     the scene as shipped with ``auto``; the 2D model at mesh ``level`` (``--level``; None: the
-    scene's, which for fig. 5 is the default ``"medium"``).
+    scene's, which for fig. 5 is the default ``"medium"``). ``kernels="jit"``: numba's JIT
+    instead of the ahead-of-time build (``SANDWICH_KERNELS``, sandwich/solver/jit.py).
     """
+    env = {k: v for k, v in os.environ.items() if k != "SANDWICH_KERNELS"}
+    if kernels is not None:
+        env["SANDWICH_KERNELS"] = kernels
     out = []
     for _ in range(repeat):
         with tempfile.TemporaryDirectory() as tmp:
@@ -184,7 +190,7 @@ def cli_run(model: str, repeat: int, auto: bool = False, level: str | None = Non
             level_args = [] if level is None else ["--level", level]
             p = subprocess.run([str(ROOT / ".venv" / "bin" / "sandwich"), "solve", str(scene),
                                 "--model", model, "--quiet", "--out", tmp, *level_args],
-                               capture_output=True, text=True, cwd=ROOT)
+                               capture_output=True, text=True, cwd=ROOT, env=env)
             whole = time.perf_counter() - t
             if p.returncode != 0:
                 raise RuntimeError(p.stderr)
@@ -200,12 +206,16 @@ def fig5_speed(repeat, with_2d):
     t_480, s_480 = in_process_path(False, repeat, elements=480)
     t_auto, s_auto = in_process_path(False, 1, auto=True)
     whole, summary = cli_run("beam", repeat)
+    whole_jit, summary_jit = cli_run("beam", repeat, kernels="jit")
     whole_auto, summary_auto = cli_run("beam", 1, auto=True)
     # 2D coarse and the scene's own level (medium): until 2026-12-02 this table's "2D coarse"
     # row ran the scene's level without --level, i.e. 2D medium, under the coarse label
     two_d = {lvl: cli_run("2d", 1, level=lvl) for lvl in ("coarse", "medium")} if with_2d else {}
     after = load()
     lam_new, lam_ref = s_new.history[-1].load_factor, s_ref.history[-1].load_factor
+    kb = kernel_backend()
+    backend = ("ahead-of-time build" if kb["backend"] == "aot"
+               else f"numba JIT — {kb['reason']}")
     lines = [
         "fig. 5 full path (paper-fig5-top-debond-40-load-top to w_top_mid = -15 mm, arc-length, "
         "240 elements, the scene's element choices — stretch faces, averaged face membrane, "
@@ -229,9 +239,13 @@ def fig5_speed(repeat, with_2d):
         f"{t_480:.3f} | – | {len(s_480.history)} | "
         f"{s_480.extra['total_newton_iterations']} | {s_480.history[-1].load_factor:.10g} | "
         f"{len(s_480.limit_points)} |",
-        f"| `sandwich solve --model beam` (CLI, warm numba cache) | "
+        f"| `sandwich solve --model beam` (CLI, kernels: {backend}) | "
         f"{summary['wall_seconds']:.3f} | {whole:.2f} | {summary['steps']} | "
         f"{summary['total_newton_iterations']} | {summary['final_load_factor']:.10g} | – |",
+        f"| the same with numba's JIT (`SANDWICH_KERNELS=jit`, warm numba cache) | "
+        f"{summary_jit['wall_seconds']:.3f} | {whole_jit:.2f} | {summary_jit['steps']} | "
+        f"{summary_jit['total_newton_iterations']} | "
+        f"{summary_jit['final_load_factor']:.10g} | – |",
         f"| as shipped, `core = \"auto\"` (in process, warm) | {t_auto:.3f} | – | "
         f"{len(s_auto.history)} | {s_auto.extra['total_newton_iterations']} | "
         f"{s_auto.history[-1].load_factor:.10g} | {len(s_auto.limit_points)} |",

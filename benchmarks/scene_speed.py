@@ -110,6 +110,17 @@ def _ratio(a, b) -> str:
     return "–" if a is None or b is None or b <= 0 else f"{a / b:.1f}×"
 
 
+def _kernel_backend() -> str:
+    """Which kernels the beam runs used (sandwich/solver/jit.py), asked of a fresh process."""
+    code = ("from sandwich.solver.jit import kernel_backend as k; b = k(); "
+            "print(b['backend'], '-', b['reason'])")
+    p = subprocess.run([str(ROOT / ".venv" / "bin" / "python"), "-c", code], capture_output=True,
+                       text=True, cwd=ROOT)
+    out = p.stdout.strip() or p.stderr.strip()[-200:]
+    return ("the ahead-of-time build (" + out.split(" - ", 1)[-1] + ")"
+            if out.startswith("aot") else f"numba's JIT ({out})")
+
+
 def markdown(rows: list[dict]) -> str:
     """The table: per scene the three runs and the 2D-coarse-over-beam ratios."""
     stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
@@ -128,7 +139,7 @@ def markdown(rows: list[dict]) -> str:
         "differ by more than the models' known gaps, the runs followed different branches or "
         "passed a load maximum on the way (the buckling and cantilever scenes: "
         "`benchmarks/results/comparisons/gallery_agreement.md`): there the costs are of "
-        "different paths.",
+        "different paths. Beam kernels: " + _kernel_backend() + ".",
         "",
         "| scene | beam auto: solve / whole (s), states, λ end | beam level 1: solve / whole (s), "
         "states, λ end | 2D coarse: solve / whole (s), states, λ end | 2D/auto solve, whole | "

@@ -13,16 +13,34 @@ call and loaded (not recompiled) by every later process. Where the cache lives:
 
 :func:`cache_directory` says which one applies. ``import numba`` is deferred to the first kernel
 module import, so code paths that never evaluate a kernel do not pay its ~0.15 s import.
+
+**Ahead-of-time build.** Loading numba and its cached kernels costs ≈ 0.5-0.6 s per process
+(``import numba``, its target initialisation, each kernel's cache entry; docs/beam_speed.md),
+more than a whole small scene's path. ``make setup`` therefore also compiles every kernel, for the
+argument types a representative workload meets, into one extension module with numba's AOT
+compiler (``scripts/build_kernels.py`` → ``sandwich/solver/_kernels_aot*.so`` and its manifest
+``_kernels_aot.json``). :func:`njit` returns a :class:`Kernel`: a call whose arguments match an
+exported signature exactly (array dtype, dimensions, layout, writeability; scalar types) runs the
+AOT function, without importing numba; any other call, or every call when the build is missing,
+stale (a kernel source file changed), made for another CPU, Python, numpy or numba, or disabled by
+``SANDWICH_KERNELS=jit``, runs numba's JIT as before. Both are the same LLVM code from the same
+source and flags (the exported wrappers call the JIT-flagged functions); the tests compare them
+bit for bit. :func:`kernel_backend` says which applies and why.
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
+import json
 import os
+import platform
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["cache_directory", "njit"]
+__all__ = ["Kernel", "cache_directory", "kernel_backend", "kernels", "njit"]
 
 _HERE = Path(__file__).resolve()
 _SOURCE_DIRS = (_HERE.parent, _HERE.parents[2] / "beam_element")  # the kernels' source dirs
@@ -74,7 +92,7 @@ def _configure() -> None:
 
 
 def njit(fn: Callable | None = None, *, reassociate: bool = False) -> Callable:
-    """``numba.njit(cache=True)``, IEEE arithmetic.
+    """A compiled kernel (:class:`Kernel`): numba ``njit(cache=True)``, IEEE arithmetic.
 
     ``reassociate=True`` lets LLVM reorder sums (fastmath flags ``reassoc`` and ``contract``
     only: NaN and infinity keep their meaning), which vectorises dot-product loops; the result
@@ -82,10 +100,169 @@ def njit(fn: Callable | None = None, *, reassociate: bool = False) -> Callable:
     """
     if fn is None:
         return lambda f: njit(f, reassociate=reassociate)
-    _configure()
-    import numba
+    return Kernel(fn, reassociate)
 
-    flags = {"reassoc", "contract"} if reassociate else False
-    # error_model "numpy": a division by zero gives inf/NaN (checked by the callers), not an
-    # exception from inside the loop
-    return numba.njit(cache=True, nogil=True, fastmath=flags, error_model="numpy")(fn)
+
+_KERNELS: list[Kernel] = []
+
+
+def kernels() -> list[Kernel]:
+    """Every kernel defined so far (those of the modules imported)."""
+    return list(_KERNELS)
+
+
+class Kernel:
+    """A numba kernel, run ahead-of-time compiled where the build has the call's signature.
+
+    Calls from Python: the AOT function whose exported signature the arguments match exactly,
+    else :attr:`jit`. Calls from other kernels (compiled code) always bind to :attr:`jit`'s
+    dispatcher (``_numba_type_``), so the AOT build links the same functions as the JIT.
+    """
+
+    def __init__(self, fn: Callable, reassociate: bool) -> None:
+        self.py_func = fn
+        self.reassociate = reassociate
+        self.key = f"{fn.__module__}.{fn.__qualname__}"
+        self._jit = None
+        self._aot: tuple | None = None
+        functools.update_wrapper(self, fn)
+        _KERNELS.append(self)
+
+    @property
+    def jit(self) -> Callable:
+        """Numba's dispatcher (built, and numba imported, on first use)."""
+        if self._jit is None:
+            _configure()
+            import numba
+
+            flags = {"reassoc", "contract"} if self.reassociate else False
+            # error_model "numpy": a division by zero gives inf/NaN (checked by the callers),
+            # not an exception from inside the loop
+            self._jit = numba.njit(cache=True, nogil=True, fastmath=flags,
+                                   error_model="numpy")(self.py_func)
+        return self._jit
+
+    @property
+    def _numba_type_(self) -> object:  # what numba sees when a kernel calls this one
+        return self.jit._numba_type_
+
+    def __call__(self, *args: object) -> object:
+        """Run the kernel: the AOT function exported for exactly these types, else the JIT."""
+        aot = self._aot
+        if aot is None:
+            aot = self._aot = _aot_exports().get(self.key, ())
+        for matches, fn in aot:
+            if matches(args):
+                return fn(*args)
+        return self.jit(*args)
+
+    def __repr__(self) -> str:
+        return f"<Kernel {self.key}>"
+
+
+# --- the ahead-of-time build ---------------------------------------------------------------
+
+AOT_MODULE = "sandwich.solver._kernels_aot"
+AOT_MANIFEST = _HERE.parent / "_kernels_aot.json"
+ROOT = _HERE.parents[2]  # the kernel sources' paths in the manifest are relative to this
+_backend = {"backend": "jit", "reason": "not loaded yet"}
+
+
+def machine_key() -> dict[str, str]:
+    """What an AOT build depends on besides the sources: CPU, Python, numpy, numba versions."""
+    cpu = ""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            seen = set()
+            for line in fh:
+                k = line.split(":", 1)[0].strip()
+                if k in ("model name", "flags") and k not in seen:
+                    seen.add(k)
+                    cpu += line
+                if len(seen) == 2:
+                    break
+    except OSError:
+        cpu = ""
+    import numpy
+
+    return {"cpu": hashlib.sha256(cpu.encode()).hexdigest() if cpu else "",
+            "machine": platform.machine(), "python": sys.version.split()[0],
+            "numpy": numpy.__version__}
+
+
+def source_digest(paths: list[str]) -> str:
+    """sha256 over the kernel source files (paths relative to the project root)."""
+    h = hashlib.sha256()
+    for rel in paths:
+        h.update(rel.encode())
+        h.update((ROOT / rel).read_bytes())
+    return h.hexdigest()
+
+
+def kernel_backend() -> dict[str, str]:
+    """``{"backend": "aot" | "jit", "reason": ...}``: whether the AOT build is used, or why not."""
+    _aot_exports()
+    return dict(_backend)
+
+
+@functools.cache
+def _aot_exports() -> dict[str, tuple]:
+    """Kernel key → ((argument matcher, AOT function), ...) from a valid build, else {}."""
+    def off(reason: str) -> dict:
+        _backend.update(backend="jit", reason=reason)
+        return {}
+
+    if os.environ.get("SANDWICH_KERNELS", "").lower() == "jit":
+        return off("SANDWICH_KERNELS=jit")
+    try:
+        manifest = json.loads(AOT_MANIFEST.read_text())
+    except (OSError, ValueError):
+        return off("no ahead-of-time build (make setup builds it)")
+    try:
+        if manifest.get("machine") != machine_key():
+            return off("the ahead-of-time build is for another machine or Python/numpy")
+        if manifest.get("sources") != source_digest(manifest["files"]):
+            return off("a kernel source changed since the ahead-of-time build")
+        if AOT_MODULE != "sandwich.solver._kernels_aot":
+            raise ImportError(f"no module {AOT_MODULE}")  # (tests point it elsewhere)
+        from sandwich.solver import _kernels_aot as module  # built by make setup
+        out = {key: tuple((_matcher(spec), getattr(module, name)) for name, spec in entries)
+               for key, entries in manifest["exports"].items()}
+    except Exception as exc:  # a broken build must never stop a run: the JIT is always there
+        return off(f"the ahead-of-time build did not load ({type(exc).__name__}: {exc})")
+    _backend.update(backend="aot", reason=f"{sum(map(len, out.values()))} exported signatures")
+    return out
+
+
+def _matcher(spec: list[list]) -> Callable[[tuple], bool]:
+    """A function telling whether call arguments have exactly the exported types ``spec``.
+
+    Each entry: ``["array", dtype, ndim, layout, writeable]`` or ``["float"]``, ``["int"]``,
+    ``["bool"]``. An AOT function does not check its arguments (a wrong dtype is a crash), so
+    nothing else is accepted.
+    """
+    import numpy as np
+
+    env = {"nd": np.ndarray, "f8": (float, np.float64), "i8": (int, np.int64),
+           "b1": (bool, np.bool_)}
+    lines = [f"def matches(args):\n    if len(args) != {len(spec)}:\n        return False"]
+    for i, s in enumerate(spec):
+        a = f"args[{i}]"
+        if s[0] == "array":
+            _, dtype, ndim, layout, writeable = s
+            env[f"d{i}"] = np.dtype(dtype)
+            cond = [f"type({a}) is not nd", f"{a}.dtype != d{i}", f"{a}.ndim != {ndim}"]
+            if layout == "C":
+                cond.append(f"not {a}.flags.c_contiguous")
+            elif layout == "F":
+                cond.append(f"not {a}.flags.f_contiguous")
+            if writeable:
+                cond.append(f"not {a}.flags.writeable")
+            cond.append(f"not {a}.flags.aligned")
+        else:
+            kind = {"float": "f8", "int": "i8", "bool": "b1"}[s[0]]
+            cond = [f"type({a}) not in {kind}"]
+        lines.append(f"    if {' or '.join(cond)}:\n        return False")
+    lines.append("    return True")
+    exec("\n".join(lines), env)  # noqa: S102 - generated from the manifest's type specs
+    return env["matches"]

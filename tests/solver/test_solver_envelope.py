@@ -320,7 +320,7 @@ def test_kernels_run_from_a_read_only_install(tmp_path):
             "f = envelope.factorize_envelope(sp.csr_matrix(np.diag([1.0, -2.0, 3.0])))\n"
             "print(f.negative_pivots, bool(os.listdir(os.environ['NUMBA_CACHE_DIR'])))\n")
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    env.update(PYTHONPATH=str(site), HOME=str(tmp_path / "nohome"),
+    env.update(PYTHONPATH=str(site), HOME=str(tmp_path / "nohome"), SANDWICH_KERNELS="jit",
                XDG_CACHE_HOME=str(tmp_path / "nohome" / ".cache"), PYTHONDONTWRITEBYTECODE="1")
     # read-only: without root, chmod; with root (mode bits ignored), a file where the cache dirs
     # would go blocks them just as well
