@@ -222,7 +222,11 @@ def table(rows: list[dict], meta: dict, constants: dict[str, float]) -> str:
     mib = 2**20
     now = {k: getattr(memory, k) for k in constants}
     lines = ["# Peak memory of the command line against the guard's estimate", "",
-             f"Measured {meta['date']} by `benchmarks/memory_guard.py` on a {meta['cpus']}-CPU "
+             f"Measured {meta['date']}"
+             + (f" (the beam rows and the import row again {meta['beam_rows_again']}, with the "
+                "kernels of the ahead-of-time build: no numba in the process)"
+                if "beam_rows_again" in meta else "")
+             + f" by `benchmarks/memory_guard.py` on a {meta['cpus']}-CPU "
              f"machine (MemTotal {meta['mem_total_gb']:.1f} GB, shared with another job: load "
              "in the last column); peak RSS = `ru_maxrss` of the command's process "
              f"(`os.wait4`). Scene: `scenes/default.toml`; beam rows to w_top_mid = {UNTIL} mm, "
@@ -268,10 +272,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--table", action="store_true", help="re-render from the stored JSON")
     ap.add_argument("--again", action="store_true", help="measure every row again")
+    ap.add_argument("--again-beam", action="store_true",
+                    help="measure the beam rows (and the import row) again, keep the 2D ones")
     args = ap.parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
     store = OUT / "memory_guard.json"
     data = json.loads(store.read_text()) if store.is_file() and not args.again else None
+    if data is not None and args.again_beam:
+        data["rows"] = [r for r in data["rows"] if r["kind"] not in ("beam", "import")]
+        data["meta"] = {**data["meta"], "beam_rows_again": time.strftime(
+            "%Y-%m-%d %H:%M UTC", time.gmtime())}
     if not args.table:
         mem = Path("/proc/meminfo").read_text()
         total = int(re.search(r"MemTotal:\s+(\d+)", mem).group(1)) * 1024

@@ -181,9 +181,16 @@ def test_the_constants_are_those_fitted_to_the_stored_measurements():
                 assert 1 / 1.25 < ratio < 1.25, (bench._row_id(r), ratio)
 
 
-def test_a_small_real_beam_run_is_within_a_factor_2_of_its_estimate(tmp_path):
-    """Measured here: peak RSS of a real solve (its own process) against the estimate."""
+def test_a_small_real_beam_run_is_within_a_factor_2_of_its_estimate(tmp_path, monkeypatch):
+    """Measured here: peak RSS of a real solve (its own process) against the estimate.
+
+    Under numba's JIT, as the stored calibration rows were measured: the kernels' ahead-of-time
+    build takes ≈ 131 MB less (numba and LLVM not loaded; paired runs in docs/beam_speed.md), so
+    the guard over-estimates such runs by that much more — on the safe side.
+    """
     import json
+
+    monkeypatch.setenv("SANDWICH_KERNELS", "jit")
 
     scene = _scene_with(tmp_path, "\n[beam_model]\nelements = 600\ncore = 3\n")
     scene.write_text(scene.read_text().replace("value = -8", "value = -0.1"))

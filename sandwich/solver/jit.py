@@ -11,8 +11,9 @@ call and loaded (not recompiled) by every later process. Where the cache lives:
 4. else (read-only install and read-only home) a directory under the system temporary directory,
    ``<tmp>/sandwich-numba-cache-<uid>``, set as ``NUMBA_CACHE_DIR`` before numba is imported.
 
-:func:`cache_directory` says which one applies. ``import numba`` is deferred to the first kernel
-module import, so code paths that never evaluate a kernel do not pay its ~0.15 s import.
+:func:`cache_directory` says which one applies. ``import numba`` is deferred to the first call
+that needs the JIT, so code paths that never do (no kernel evaluated, or every call covered by the
+ahead-of-time build below) do not pay it.
 
 **Ahead-of-time build.** Loading numba and its cached kernels costs ≈ 0.5-0.6 s per process
 (``import numba``, its target initialisation, each kernel's cache entry; docs/beam_speed.md),
@@ -100,7 +101,16 @@ def njit(fn: Callable | None = None, *, reassociate: bool = False) -> Callable:
     """
     if fn is None:
         return lambda f: njit(f, reassociate=reassociate)
+    if not _numba_installed():  # as numba.njit would: the callers fall back to NumPy/SuperLU
+        raise ImportError("numba is not installed")
     return Kernel(fn, reassociate)
+
+
+@functools.cache
+def _numba_installed() -> bool:
+    from importlib.util import find_spec
+
+    return find_spec("numba") is not None
 
 
 _KERNELS: list[Kernel] = []
