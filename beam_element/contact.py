@@ -197,11 +197,7 @@ def contact_pairs(
     # (at least one segment per side, stopping at the mesh ends). A common width 2k + 1 keeps the
     # arrays rectangular; slots beyond a node's own range repeat its end node (no extra coupling
     # in the sparse pattern) and their segments are marked invalid.
-    tol = 1e-12 * (x[-1] - x[0])
-    lo = np.searchsorted(x, x[nodes] - reach + tol, side="right") - 1
-    lo = np.clip(np.minimum(lo, nodes - 1), 0, None)
-    hi = np.searchsorted(x, x[nodes] + reach - tol, side="left")
-    hi = np.clip(np.maximum(hi, nodes + 1), None, x.size - 1)
+    lo, hi = _search_range(nodes, x, reach)
     k = int(max(np.max(nodes - lo, initial=1), np.max(hi - nodes, initial=1)))
     raw = nodes[:, None] + np.arange(-k, k + 1)[None, :]
     core_nodes = np.clip(raw, lo[:, None], hi[:, None])
@@ -209,6 +205,16 @@ def contact_pairs(
     core = np.stack([global_dof(core_nodes, names[r]) for r in CORE_NODE_ROLES], axis=-1)
     support = np.concatenate([dofs[:, :2], core.reshape(nodes.size, -1)], axis=1)
     return ContactPairs(interface, nodes, area, dofs, search, x, core_nodes, valid, support)
+
+
+def _search_range(nodes: np.ndarray, x: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """First and last core node each face node searches: ``reach`` mm each side, ≥ 1 segment."""
+    tol = 1e-12 * (x[-1] - x[0])
+    lo = np.searchsorted(x, x[nodes] - reach + tol, side="right") - 1
+    lo = np.clip(np.minimum(lo, nodes - 1), 0, None)
+    hi = np.searchsorted(x, x[nodes] + reach - tol, side="left")
+    hi = np.clip(np.maximum(hi, nodes + 1), None, x.size - 1)
+    return lo, hi
 
 
 def contact_pair_groups(
@@ -226,10 +232,10 @@ def contact_pair_groups(
     nodes = np.asarray(nodes, dtype=int)
     if search != "closest-point" or nodes.size == 0:
         return [contact_pairs(interface, nodes, x, width, search=search, reach=reach)]
-    k = np.ones(nodes.size, dtype=int)
-    for i in range(nodes.size):  # the half-width each node needs (as in contact_pairs)
-        k[i] = contact_pairs(interface, nodes[i:i + 1], x, width, search=search,
-                             reach=reach).core_nodes.shape[1] // 2
+    if not (np.isfinite(reach) and reach >= 0):
+        raise ValueError(f"contact reach must be >= 0 mm, got {reach!r}")
+    lo, hi = _search_range(nodes, x, reach)  # the half-width each node needs, as contact_pairs
+    k = np.maximum(np.maximum(nodes - lo, hi - nodes), 1)
     bins = 2 ** np.ceil(np.log2(k)).astype(int)
     parent = contact_pairs(interface, nodes, x, width, search=search, reach=reach)
     groups = []

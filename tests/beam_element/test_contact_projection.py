@@ -322,6 +322,24 @@ def test_groups_by_search_width_give_the_ungrouped_force_and_tangent():
     assert np.allclose(K1, K2, rtol=0, atol=1e-12 * np.abs(K2).max())
 
 
+@pytest.mark.parametrize("reach", [0.0, 0.4, 1.0, 2.5])
+def test_groups_hold_each_node_at_its_own_search_width(reach):
+    """Each node lands in the group of its own half-width (the single-node search of
+    contact_pairs), rounded up to a power of two; every node once; mesh ends included."""
+    x = np.concatenate([[0.0], np.cumsum([3, 2, 1, 0.5, 0.3, 0.2, 0.2, 0.3, 0.5, 1, 2, 3.0])])
+    nodes = np.arange(x.size)
+    groups = contact_pair_groups("top", nodes, x, 60.0, search="closest-point", reach=reach)
+    assert sorted(np.concatenate([g.nodes for g in groups]).tolist()) == nodes.tolist()
+    for g in groups:
+        for node in g.nodes:
+            own = contact_pairs("top", np.array([node]), x, 60.0, search="closest-point",
+                                reach=reach).core_nodes.shape[1] // 2
+            assert g.core_nodes.shape[1] // 2 <= 2 ** int(np.ceil(np.log2(own)))
+        widths = [contact_pairs("top", np.array([m]), x, 60.0, search="closest-point",
+                                reach=reach).core_nodes.shape[1] // 2 for m in g.nodes]
+        assert len({2 ** int(np.ceil(np.log2(w))) for w in widths}) == 1
+
+
 # A uniform mesh of 0.25 mm elements: a 1 mm reach spans four segments on each side of a node,
 # and a sliding of 2 mm takes the projection well beyond them (fig. 7 c3 at 240 elements: the
 # core's bottom boundary slides ~1.3 mm along the debonded face at the clamp).
