@@ -612,26 +612,15 @@ class _Follower:
     ) -> tuple[_Trial, float, str]:
         """If ``trial`` overshoots a stopping target, shorten the step to hit it.
 
-        First with the target itself as the control equation (:meth:`_attempt_target`: load or
-        displacement control of the crossed quantity from ``last``, in sub-increments where a
-        corrector fails), which hits it exactly; where that fails, the step size
-        ``x ∈ (0, h)`` is found by regula falsi with the Illinois modification on
+        The step size ``x ∈ (0, h)`` is found by regula falsi with the Illinois modification on
         ``g(x) = value(step of size x) − target``, each evaluation a full corrector run from
-        ``last``, to ``target_tol``. Returns the step to accept, its size and the crossed
-        target's name ("" if none was crossed).
-
-        Direct control first (2026-12-03, docs/beam_speed.md): the regula falsi took 2-4
-        correctors on every path, and where it could not reach ``target_tol`` (fig. 7 c1: 84
-        of the path's 176 Newton iterations) the direct control ran after it anyway.
+        ``last``. Returns the step to accept, its size and the crossed target's name ("" if
+        none was crossed).
         """
         crossed = self._crossings(last, trial)
         if not crossed:
             return trial, h, ""
         _, name, target = crossed[0]
-        direct = self._attempt_target(name, target, last, t)
-        if direct is not None:
-            return direct, self.wnorm(direct.u - last.u,
-                                      direct.load_factor - last.load_factor), name
         scale = max(abs(target), *(abs(self._value(name, s.u, s.load_factor))
                                    for s in self.states))
         tol = self.opt.target_tol * scale
@@ -666,6 +655,14 @@ class _Follower:
                 if side == 1:
                     fb *= 0.5
                 side = 1
+        if abs(best_g) > tol:
+            # The arc through the bracket can lose its real roots on short arcs (Crisfield's
+            # quadratic); the target itself is then a better control equation: one corrector
+            # from ``last`` with "value(name) = target" (load or displacement control).
+            direct = self._attempt_target(name, target, last, t)
+            if direct is not None:
+                return direct, self.wnorm(direct.u - last.u,
+                                          direct.load_factor - last.load_factor), name
         return best, best_h, name
 
     def _rescue_due(self, cuts: int, h: float) -> bool:

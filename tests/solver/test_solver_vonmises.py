@@ -124,24 +124,3 @@ def test_max_steps_stops_with_states_kept():
     assert "max_steps = 3" in result.message
     assert [s.step for s in result.states] == [0, 1, 2, 3]
     _assert_on_curve(truss, result)
-
-
-@pytest.mark.parametrize("target", [("w", 3.0), ("λ", 3.0)])
-def test_a_crossed_target_is_hit_exactly_by_its_own_control(target):
-    """The arc overshoots the target; the last step is taken under control of the target's
-    quantity (displacement or load control from the last state), so the target is hit to
-    round-off, not only within ``target_tol`` (regula falsi on the arc length, the fallback)."""
-    truss = VonMisesTruss()
-    (_, l_max), _ = truss.limit_points()
-    name, scale = target
-    value = scale * (truss.h if name == "w" else l_max)
-    kw = ({"until_probe": "w", "until_value": value} if name == "w"
-          else {"until_load_factor": value})
-    opts = PathOptions(control="arc-length", tol=TOL, max_increment=0.05, max_steps=500, **kw)
-    result = follow_path(truss, opts, ["w"])
-    assert result.reached_target, result.message
-    last = result.states[-1]
-    got = last.probes["w"] if name == "w" else last.load_factor
-    assert abs(got - value) <= 1e-12 * abs(value), (got, value)
-    assert abs(got - value) < 1e-3 * opts.target_tol * abs(value)  # far inside target_tol
-    _assert_on_curve(truss, result)
