@@ -261,18 +261,17 @@ def _matcher(spec: list[list]) -> Callable[[tuple], bool]:
         if s[0] == "array":
             _, dtype, ndim, layout, writeable = s
             env[f"d{i}"] = np.dtype(dtype)
-            cond = [f"type({a}) is not nd", f"{a}.dtype != d{i}", f"{a}.ndim != {ndim}"]
-            if layout == "C":
-                cond.append(f"not {a}.flags.c_contiguous")
-            elif layout == "F":
-                cond.append(f"not {a}.flags.f_contiguous")
-            if writeable:
-                cond.append(f"not {a}.flags.writeable")
-            cond.append(f"not {a}.flags.aligned")
+            flags = [{"C": "c_contiguous", "F": "f_contiguous"}.get(layout), "aligned",
+                     "writeable" if writeable else None]
+            lines += [f"    a = {a}",
+                      f"    if type(a) is not nd or a.ndim != {ndim}:\n        return False",
+                      f"    t = a.dtype\n    if t is not d{i} and t != d{i}:\n        return False",
+                      "    f = a.flags",  # one flags object per array (each access makes one)
+                      f"    if not ({' and '.join(f'f.{x}' for x in flags if x)}):\n"
+                      "        return False"]
         else:
             kind = {"float": "f8", "int": "i8", "bool": "b1"}[s[0]]
-            cond = [f"type({a}) not in {kind}"]
-        lines.append(f"    if {' or '.join(cond)}:\n        return False")
+            lines.append(f"    if type({a}) not in {kind}:\n        return False")
     lines.append("    return True")
     exec("\n".join(lines), env)  # noqa: S102 - generated from the manifest's type specs
     return env["matches"]
