@@ -232,12 +232,10 @@ def contact_pair_groups(
     nodes = np.asarray(nodes, dtype=int)
     if search != "closest-point" or nodes.size == 0:
         return [contact_pairs(interface, nodes, x, width, search=search, reach=reach)]
-    if not (np.isfinite(reach) and reach >= 0):
-        raise ValueError(f"contact reach must be >= 0 mm, got {reach!r}")
+    parent = contact_pairs(interface, nodes, x, width, search=search, reach=reach)  # checks
     lo, hi = _search_range(nodes, x, reach)  # the half-width each node needs, as contact_pairs
     k = np.maximum(np.maximum(nodes - lo, hi - nodes), 1)
     bins = 2 ** np.ceil(np.log2(k)).astype(int)
-    parent = contact_pairs(interface, nodes, x, width, search=search, reach=reach)
     groups = []
     for b in np.unique(bins):
         rows = np.flatnonzero(bins == b)

@@ -147,10 +147,8 @@ def stale() -> bool:
         manifest = json.loads(jit.AOT_MANIFEST.read_text())
         import numba
 
-        return not (manifest["machine"] == jit.machine_key()
-                    and manifest["numba"] == numba.__version__
-                    and manifest["sources"] == jit.source_digest(manifest["files"])
-                    and any(jit.AOT_MANIFEST.parent.glob("_kernels_aot*.so")))
+        return bool(jit.manifest_mismatch(manifest) or manifest["numba"] != numba.__version__
+                    or not any(jit.AOT_MANIFEST.parent.glob("_kernels_aot*.so")))
     except (OSError, ValueError, KeyError):
         return True
 

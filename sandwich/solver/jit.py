@@ -23,8 +23,9 @@ compiler (``scripts/build_kernels.py`` → ``sandwich/solver/_kernels_aot*.so`` 
 ``_kernels_aot.json``). :func:`njit` returns a :class:`Kernel`: a call whose arguments match an
 exported signature exactly (array dtype, dimensions, layout, writeability; scalar types) runs the
 AOT function, without importing numba; any other call, or every call when the build is missing,
-stale (a kernel source file changed), made for another CPU, Python, numpy or numba, or disabled by
-``SANDWICH_KERNELS=jit``, runs numba's JIT as before. Both are the same LLVM code from the same
+stale (a kernel source file changed), made for another CPU, Python or numpy (``make setup``
+also rebuilds it for another numba), or disabled by ``SANDWICH_KERNELS=jit``, runs numba's JIT as
+before. Both are the same LLVM code from the same
 source and flags (the exported wrappers call the JIT-flagged functions); the tests compare them
 bit for bit. :func:`kernel_backend` says which applies and why.
 """
@@ -179,7 +180,11 @@ _backend = {"backend": "jit", "reason": "not loaded yet"}
 
 
 def machine_key() -> dict[str, str]:
-    """What an AOT build depends on besides the sources: CPU, Python, numpy, numba versions."""
+    """What an AOT build depends on besides the sources and numba: CPU, Python, numpy.
+
+    ``cpu`` is empty where ``/proc/cpuinfo`` cannot be read; no build is used there
+    (:func:`manifest_mismatch`): machine code for another CPU would not fail cleanly.
+    """
     cpu = ""
     try:
         with open("/proc/cpuinfo") as fh:
@@ -209,6 +214,18 @@ def source_digest(paths: list[str]) -> str:
     return h.hexdigest()
 
 
+def manifest_mismatch(manifest: dict) -> str:
+    """Why the build described by ``manifest`` must not be used here ("" if it may)."""
+    here = machine_key()
+    if not here["cpu"]:
+        return "this machine's CPU cannot be identified (no /proc/cpuinfo)"
+    if manifest.get("machine") != here:
+        return "the ahead-of-time build is for another machine or Python/numpy"
+    if manifest.get("sources") != source_digest(manifest["files"]):
+        return "a kernel source changed since the ahead-of-time build"
+    return ""
+
+
 def kernel_backend() -> dict[str, str]:
     """``{"backend": "aot" | "jit", "reason": ...}``: whether the AOT build is used, or why not."""
     _aot_exports()
@@ -229,10 +246,9 @@ def _aot_exports() -> dict[str, tuple]:
     except (OSError, ValueError):
         return off("no ahead-of-time build (make setup builds it)")
     try:
-        if manifest.get("machine") != machine_key():
-            return off("the ahead-of-time build is for another machine or Python/numpy")
-        if manifest.get("sources") != source_digest(manifest["files"]):
-            return off("a kernel source changed since the ahead-of-time build")
+        mismatch = manifest_mismatch(manifest)
+        if mismatch:
+            return off(mismatch)
         if AOT_MODULE != "sandwich.solver._kernels_aot":
             raise ImportError(f"no module {AOT_MODULE}")  # (tests point it elsewhere)
         from sandwich.solver import _kernels_aot as module  # built by make setup

@@ -78,6 +78,20 @@ def test_a_stale_foreign_or_broken_build_is_not_used(tmp_path, monkeypatch, chan
         jit._aot_exports.cache_clear()
 
 
+def test_no_build_is_used_where_the_cpu_cannot_be_identified(tmp_path, monkeypatch):
+    """A build made and checked without /proc/cpuinfo would match any CPU: refused."""
+    monkeypatch.delenv("SANDWICH_KERNELS", raising=False)
+    real = jit.machine_key
+    try:
+        monkeypatch.setattr(jit, "machine_key", lambda: {**real(), "cpu": ""})
+        _manifest_at(tmp_path, monkeypatch)  # a manifest matching that key exactly
+        assert jit._aot_exports() == {}
+        assert "cannot be identified" in jit.kernel_backend()["reason"]
+    finally:
+        monkeypatch.undo()
+        jit._aot_exports.cache_clear()
+
+
 def test_missing_build_and_the_jit_switch(tmp_path, monkeypatch):
     try:
         monkeypatch.setattr(jit, "AOT_MANIFEST", tmp_path / "none.json")
