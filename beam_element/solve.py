@@ -23,6 +23,7 @@ from beam_element.core_levels import (
     lookahead_levels,
     raise_levels,
     state_shares,
+    transfer,
     zone_levels,
 )
 from beam_element.fields import profile_columns, section_fields
@@ -62,6 +63,12 @@ PENALTY_GROWTH = 2.0
 CORE_RECHECKS = 3
 RERUN_STEP_FACTOR = 3
 RERUN_MIN_STEPS = 30
+# Each raise is first tried on the checked pass's end state alone (solve._end_state): Newton
+# with up to END_STATE_BACKTRACKS halvings per correction, END_STATE_ITERATIONS corrections.
+END_STATE_CHECKS = True
+END_STATE_MATCH = 1e-5  # relative: the pass at the checked levels must end at the check's load
+END_STATE_ITERATIONS = 40
+END_STATE_BACKTRACKS = 20
 
 
 @dataclass(frozen=True)
@@ -253,9 +260,13 @@ def run(
         states, message = _linear_states(model, scene)
         converged = True
     else:
-        previous: ConvergedState | None = None
+        previous: float | None = None  # end load at the levels the current ones raised
         kept: tuple | None = None  # the last pass that reached the target, and its levels
-        for recheck in range(CORE_RECHECKS + 1):
+        raises = 0
+        checks = END_STATE_CHECKS and a.until_probe is not None
+        pending: tuple | None = None  # the end-state check this pass must confirm
+        failed: set[bytes] = set()  # levels whose end-state check did not converge
+        while True:
             budget = None if kept is None else min(
                 int(a.max_steps), max(RERUN_MIN_STEPS, RERUN_STEP_FACTOR * (len(kept[0][1]) - 1)))
             result = _follow_penalised(scene, elements, {**options, "core_level": choice.levels},
@@ -264,6 +275,25 @@ def run(
             last = states[-1]
             if choice.how != "auto" or last.load_factor == 0.0:
                 break
+            if pending is not None:
+                checked_load, start = pending
+                pending = None
+                if not converged or abs(last.load_factor - checked_load) > \
+                        END_STATE_MATCH * abs(last.load_factor):
+                    # The path at these levels does not end at the continued end state (another
+                    # equilibrium at the same deflection: fig. 6, fig. 4's rerun stopping short):
+                    # the checks are not the paths' ends here. From the pass they started at,
+                    # follow the path after every raise, as without them.
+                    checks = False
+                    kept, first, previous, raises = start
+                    if not np.array_equal(first, choice.levels):
+                        choice.passes.append({"stage": f"path step {last.step}",
+                                              "elements_per_level": level_counts(choice.levels),
+                                              "load_factor": last.load_factor,
+                                              "reached": converged, "estimate": None,
+                                              "end_state_confirmed": False})
+                        choice.levels = first
+                        continue
             if not converged and kept is not None:
                 # The raised path stopped short of the target: keep the pass it was checking.
                 choice.passes.append({"stage": f"path step {last.step}",
@@ -275,40 +305,36 @@ def run(
                     choice.estimate = kept
                 break
             if previous is not None:  # the change the last raise made is the estimate
-                choice.estimate = (abs(last.load_factor - previous.load_factor)
-                                   / abs(last.load_factor) if converged else None)
+                choice.estimate = (abs(last.load_factor - previous) / abs(last.load_factor)
+                                   if converged else None)
             choice.passes.append({"stage": f"path step {last.step}",
                                   "elements_per_level": level_counts(choice.levels),
                                   "load_factor": last.load_factor, "reached": converged,
                                   "estimate": choice.estimate if previous is not None else None})
             tol, top = float(bm.tolerance), int(bm.max_core_level)
-            if not converged or not np.any(choice.levels < top) or recheck == CORE_RECHECKS or (
+            if not converged or not np.any(choice.levels < top) or raises == CORE_RECHECKS or (
                     choice.estimate is not None and previous is not None
                     and choice.estimate <= tol):
                 break
             kept = (result, choice.levels.copy(), choice.estimate)
-            up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
-                             **{**options, "core_level": lookahead_levels(choice.levels)})
-            shares = state_shares(model, last.u, last.load_factor, up)
-            marked = raise_levels(choice.levels, shares, DORFLER_FRACTION * shares.sum(), top)
-            # The residual points at singular spots (debond tips, point supports), where a raise
-            # hardly moves the load; the load error of a buckled debond lives in the contact
-            # strip all along it (fig. 5: residual shares 81 % at the tips, load change there
-            # 0.5 %, true error 12 %). So every element over a debond or a load patch is raised
-            # too, and the rerun measures what that does.
-            zone = np.minimum(choice.levels + 1, top)
-            inside = _local_zone_elements(scene, model)
-            # no level change next to a debond tip: it biases G (docs/fracture.md)
-            raised_levels = uniform_tip_levels(model, beam_tips(scene, model),
-                                               np.where(inside, np.maximum(marked, zone), marked))
-            if np.any(inside) and not np.any(raised_levels[inside] > choice.levels[inside]):
-                # The zones are at the cap: a rerun would raise only elements where the load
-                # error does not live, and its small change would read as convergence (demo
-                # scene: 0.05 % for a true 4.8 %). Stop; the last estimate stands.
+            levels = _raised_levels(scene, elements, options, model, last, choice.levels, top)
+            if levels is None:
                 capped = True
                 break
-            choice.levels = raised_levels
-            previous = last
+            raises += 1
+            previous = last.load_factor
+            choice.levels = levels
+            if checks:
+                # Before following the path at the raised levels, continue its end state into
+                # them: where the path at those levels ends there (the pass that follows
+                # confirms it, else the checks are dropped), a raise that proves too small
+                # costs one Newton solve instead of a path.
+                start = (kept, levels, previous, raises)
+                found = _check_end_states(scene, elements, options, model, last, levels,
+                                          previous, raises, tol, top, choice.passes, failed)
+                if found is not None:
+                    choice.levels, previous, raises, checked_load = found
+                    pending = (checked_load, start)
             if progress is not None:
                 progress(CoreRecheck(level_counts(choice.levels)))
         if stopped_rerun:
@@ -360,6 +386,105 @@ def run(
     }
     solution.wall_seconds = time.perf_counter() - t0
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _raised_levels(scene: object, elements: int | None, options: dict, model: BeamModel,
+                   last: ConvergedState, levels: np.ndarray, top: int) -> np.ndarray | None:
+    """The levels a rerun checks after ``last``, or None where the zones are at the cap.
+
+    The elements carrying DORFLER_FRACTION of the state shares (:func:`state_shares`) are raised,
+    and so is every element over a debond or a load patch: the residual points at singular spots
+    (debond tips, point supports), where a raise hardly moves the load, while the load error of
+    a buckled debond lives in the contact strip all along it (fig. 5: residual shares 81 % at the
+    tips, load change there 0.5 %, true error 12 %). None when those zones cannot be raised: a
+    rerun would raise only elements where the load error does not live, and its small change
+    would read as convergence (demo scene: 0.05 % for a true 4.8 %).
+    """
+    up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                     **{**options, "core_level": lookahead_levels(levels)})
+    shares = state_shares(model, last.u, last.load_factor, up)
+    marked = raise_levels(levels, shares, DORFLER_FRACTION * shares.sum(), top)
+    zone = np.minimum(levels + 1, top)
+    inside = _local_zone_elements(scene, model)
+    # no level change next to a debond tip: it biases G (docs/fracture.md)
+    raised = uniform_tip_levels(model, beam_tips(scene, model),
+                                np.where(inside, np.maximum(marked, zone), marked))
+    if np.any(inside) and not np.any(raised[inside] > levels[inside]):
+        return None
+    return raised
+
+
+def _check_end_states(
+    scene: object, elements: int | None, options: dict, model: BeamModel,
+    last: ConvergedState, levels: np.ndarray, previous: float, raises: int, tol: float,
+    top: int, passes: list[dict], failed: set[bytes],
+) -> tuple[np.ndarray, float, int, float] | None:
+    """Raise on end states alone while the change they show exceeds ``tol``.
+
+    From ``last`` (the end of the pass at the levels below ``levels``, end load ``previous``),
+    each check continues the end state into the raised levels (:func:`_end_state`); while its
+    change exceeds ``tol`` (and raises remain, the zones are not at the cap) the levels are
+    raised again from it. Returns the levels of the last check that converged, the end load at
+    the levels below them, the raises count and the check's end load — the pass that follows
+    must end there — or None if the first check fails. Each check is listed in ``passes``;
+    ``failed`` holds the levels whose check failed (not tried again).
+    """
+    found = None
+    cur, state = model, last
+    while True:
+        key = levels.tobytes()
+        checked = None if key in failed else _end_state(scene, elements, options, cur, state,
+                                                         levels)
+        if checked is None:
+            failed.add(key)  # not tried again from the pass at the levels below (fig. 4)
+            return found
+        up, state = checked
+        estimate = abs(state.load_factor - previous) / abs(state.load_factor)
+        passes.append({"stage": f"end state at step {last.step}",
+                       "elements_per_level": level_counts(levels),
+                       "load_factor": state.load_factor, "reached": True,
+                       "estimate": estimate, "iterations": state.iterations})
+        found = (levels, previous, raises, state.load_factor)
+        if estimate <= tol or not np.any(levels < top) or raises == CORE_RECHECKS:
+            return found
+        higher = _raised_levels(scene, elements, options, up, state, levels, top)
+        if higher is None:
+            return found
+        cur, previous, levels, raises = up, state.load_factor, higher, raises + 1
+
+
+def _end_state(
+    scene: object, elements: int | None, options: dict, model: BeamModel,
+    state: ConvergedState, levels: np.ndarray,
+) -> tuple[BeamModel, ConvergedState] | None:
+    """``state`` (at the until target) continued into the model at ``levels``, or None.
+
+    The state is carried over (new enrichment amplitudes zero) and re-equilibrated at the same
+    value of the until probe by Newton with a backtracking line search
+    (:func:`sandwich.solver.newton.newton_correct`, ``backtracks``): the equilibrium of the
+    raised model nearest the checked one, which is where the raised path ends when it stays on
+    the same branch. None if that Newton fails or the state penetrates deeper than the bound.
+    """
+    from sandwich.solver.controls import ProbeConstraint
+    from sandwich.solver.newton import NewtonSettings, newton_correct
+
+    a = scene.analysis
+    up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
+                     **{**options, "core_level": levels})
+    c = np.asarray(up.probe_vector(a.until_probe), dtype=float)
+    settings = NewtonSettings(tol=float(a.tol), max_iterations=END_STATE_ITERATIONS,
+                              force_floor=float(np.linalg.norm(up.f_ref)) * abs(state.load_factor),
+                              backtracks=END_STATE_BACKTRACKS)
+    res = newton_correct(up, transfer(state.u, model, up), state.load_factor,
+                         ProbeConstraint(c, float(a.until_value), lambda x, y: float(x @ y)),
+                         settings)
+    if not res.converged or res.load_factor == 0.0:
+        return None
+    if _max_penetration(up, [ConvergedState(0, res.load_factor, res.u, 0, {})]) > \
+            up.penetration_bound():
+        return None
+    probes = {n: float(np.asarray(up.probe_vector(n)) @ res.u) for n in up.probe_rows}
+    return up, ConvergedState(state.step, float(res.load_factor), res.u, res.iterations, probes)
 
 
 def _path_passes(choice: LevelChoice) -> int:

@@ -16,6 +16,14 @@ the residual test does not, a residual at or below that floor is accepted ("conv
 round-off floor"): the tolerance is fixed for the whole path while the round-off of a softening
 structure grows along it (the 2D cantilevers c3/c4 stalled that way, docs/reference2d.md).
 
+Line search (``backtracks`` > 0, off by default): a correction that does not lower ``‖R‖`` is
+halved, up to ``backtracks`` times; if none lowers it the corrector fails there. For a start far
+from equilibrium — a converged state carried into a refined model, whose full corrections
+overshoot into the buckled face's other shape (fig. 5's end state: the undamped iteration's
+residual grows by 1e4) — the damped iterates descend until the quadratic phase takes over with
+full steps. A probe or load constraint stays satisfied to first order: each iteration's δλ is
+recomputed from the current iterate.
+
 Divergence (reported as a failed :class:`NewtonResult`, never raised): a non-finite residual or
 iterate, a singular tangent, a constraint without solution, a residual grown by more than
 ``divergence_factor`` over the first one, or ``max_iterations`` corrections without convergence.
@@ -53,6 +61,7 @@ class NewtonSettings:
     psi: float = 1.0
     force_floor: float = 0.0
     divergence_factor: float = 1e4
+    backtracks: int = 0  # halvings of a correction that does not lower ‖R‖ (0: plain Newton)
 
 
 @dataclass
@@ -127,12 +136,16 @@ def newton_correct(
     def fail(reason: str, its: int) -> NewtonResult:
         return NewtonResult(False, u0.copy(), lam0, its, r_norm, reason)
 
+    trial_force = None  # f_int at the iterate, when the line search has evaluated it
     with np.errstate(all="ignore"):
         for it in range(settings.max_iterations + 1):
-            try:
-                f_int = np.asarray(system.internal_force(u), dtype=float)
-            except RECOVERABLE_ERRORS as exc:
-                return fail(f"internal force failed: {exc}", it)
+            if trial_force is None:
+                try:
+                    f_int = np.asarray(system.internal_force(u), dtype=float)
+                except RECOVERABLE_ERRORS as exc:
+                    return fail(f"internal force failed: {exc}", it)
+            else:
+                f_int, trial_force = trial_force, None
             res = f_int - lam * f_ref
             r_norm = norm(res)
             if not math.isfinite(r_norm):
@@ -170,6 +183,13 @@ def newton_correct(
             du = du_r + dlam * du_f
             if not math.isfinite(dot(du, du)):
                 return fail("non-finite correction", it)
+            if settings.backtracks > 0:
+                searched = _backtrack(system, u, lam, du, dlam, r_norm, settings.backtracks,
+                                      norm, f_ref)
+                if searched is None:
+                    return fail(f"no decrease of the residual along the correction in "
+                                f"{settings.backtracks} halvings", it)
+                du, dlam, trial_force = searched
             u = u + du
             lam = lam + dlam
             last_step = _norm(du, dlam, psi, dot)
@@ -177,6 +197,28 @@ def newton_correct(
         f"no convergence in {settings.max_iterations} iterations (residual {r_norm:.3e})",
         settings.max_iterations,
     )
+
+
+def _backtrack(
+    system: DiscreteSystem, u: np.ndarray, lam: float, du: np.ndarray, dlam: float,
+    r_norm: float, halvings: int, norm: object, f_ref: np.ndarray,
+) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """The correction scaled by the first of 1, ½, ¼, … that lowers ‖R‖ below ``r_norm``.
+
+    Returns the scaled correction and f_int at its iterate, or None when ``halvings`` halvings
+    found no decrease (the iterate is then not a descent start: the corrector fails there
+    instead of creeping on).
+    """
+    alpha = 1.0
+    for _ in range(halvings + 1):
+        try:
+            f_int = np.asarray(system.internal_force(u + alpha * du), dtype=float)
+        except RECOVERABLE_ERRORS:
+            f_int = None
+        if f_int is not None and norm(f_int - (lam + alpha * dlam) * f_ref) < r_norm:
+            return alpha * du, alpha * dlam, f_int
+        alpha *= 0.5
+    return None
 
 
 def _solve_both(fac: object, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,97 @@
+"""``auto`` core levels: a raise is first tried on the checked pass's end state alone.
+
+The reference is the path itself: the same scene with the end-state checks switched off
+(``solve.END_STATE_CHECKS = False``) follows the whole path again after every raise (the scheme
+before them). Where a continued end state is where the path at its levels ends, both choose the
+same levels and report the same end load and estimate, and the checks save the intermediate
+paths; where it is not (another equilibrium at the same deflection), the pass that follows the
+checks says so and the run goes back to following the path after every raise, so the answer
+is again the reruns' one.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beam_element import run
+from sandwich.scene_file import load_scene
+
+solve = sys.modules["beam_element.solve"]  # the module (the package exports a function)
+C1 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig7-cantilever-c1.toml"
+
+
+def _stages(r, prefix):
+    return [p for p in r.solution.extra["core"]["passes"] if p["stage"].startswith(prefix)]
+
+
+def _both(elements):
+    scene = load_scene(C1)
+    checked = run(scene, elements=elements)
+    solve.END_STATE_CHECKS = False
+    try:
+        rerun = run(scene, elements=elements)
+    finally:
+        solve.END_STATE_CHECKS = True
+    return checked, rerun
+
+
+@pytest.fixture(scope="module")
+def confirmed():
+    """fig. 7 c1 as shipped (240 elements): two raises on end states, one path at the end."""
+    return _both(None)
+
+
+@pytest.fixture(scope="module")
+def unconfirmed():
+    """c1 at 40 elements: the raised path ends on another equilibrium than the check's."""
+    return _both(40)
+
+
+def _same_answer(checked, rerun):
+    assert checked.solution.converged and rerun.solution.converged
+    np.testing.assert_array_equal(checked.model.element_levels, rerun.model.element_levels)
+    assert checked.solution.final_load_factor == pytest.approx(
+        rerun.solution.final_load_factor, rel=1e-9)
+    est_c = checked.solution.extra["core"]["estimated_error"]
+    est_r = rerun.solution.extra["core"]["estimated_error"]
+    assert est_c == pytest.approx(est_r, rel=1e-6)
+
+
+def test_confirmed_end_states_give_the_reruns_answer_with_fewer_paths(confirmed):
+    checked, rerun = confirmed
+    _same_answer(checked, rerun)
+    assert len(_stages(checked, "path step")) < len(_stages(rerun, "path step"))
+
+
+def test_each_end_state_is_where_the_rerun_at_its_levels_ends(confirmed):
+    checked, rerun = confirmed
+    ends = _stages(checked, "end state")
+    by_levels = {str(p["elements_per_level"]): p["load_factor"]
+                 for p in _stages(rerun, "path step")}
+    assert len(ends) >= 2, checked.solution.extra["core"]["passes"]
+    for e in ends:
+        key = str(e["elements_per_level"])
+        assert key in by_levels, (key, list(by_levels))
+        assert e["load_factor"] == pytest.approx(by_levels[key], rel=1e-6)
+
+
+def test_an_unconfirmed_end_state_goes_back_to_the_reruns(unconfirmed):
+    checked, rerun = unconfirmed
+    ends = _stages(checked, "end state")
+    paths = {str(p["elements_per_level"]): p["load_factor"] for p in _stages(rerun, "path step")}
+    assert any(e["load_factor"] != pytest.approx(paths.get(str(e["elements_per_level"]), 0.0),
+                                                 rel=1e-3) for e in ends)  # the premise
+    _same_answer(checked, rerun)
+
+
+def test_a_failed_end_state_falls_back_to_following_the_path(monkeypatch, confirmed):
+    _, rerun = confirmed
+    monkeypatch.setattr(solve, "_end_state", lambda *args: None)
+    r = run(load_scene(C1))
+    assert not _stages(r, "end state")
+    assert [p["load_factor"] for p in _stages(r, "path step")] == [
+        p["load_factor"] for p in _stages(rerun, "path step")]
