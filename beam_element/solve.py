@@ -324,7 +324,7 @@ def run(
             raises += 1
             previous = last.load_factor
             choice.levels = levels
-            if checks:
+            if checks and _at_probe_target(a, last):
                 # Before following the path at the raised levels, continue its end state into
                 # them: where the path at those levels ends there (the pass that follows
                 # confirms it, else the checks are dropped), a raise that proves too small
@@ -412,6 +412,12 @@ def _raised_levels(scene: object, elements: int | None, options: dict, model: Be
     if np.any(inside) and not np.any(raised[inside] > levels[inside]):
         return None
     return raised
+
+
+def _at_probe_target(analysis: object, state: ConvergedState) -> bool:
+    """Whether ``state`` ended the path at the until probe's target (not at a load target)."""
+    target = float(analysis.until_value)
+    return abs(state.probes[analysis.until_probe] - target) <= 1e-4 * max(abs(target), 1e-12)
 
 
 def _check_end_states(

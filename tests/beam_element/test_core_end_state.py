@@ -11,6 +11,7 @@ is again the reruns' one.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -47,8 +48,9 @@ def confirmed():
 
 @pytest.fixture(scope="module")
 def unconfirmed():
-    """c1 at 40 elements: the raised path ends on another equilibrium than the check's."""
-    return _both(40)
+    """c1 at 60 elements: two raises on end states (933.7, then 898.6), and the path at the
+    levels of the second ends elsewhere (690.9: another equilibrium at the same deflection)."""
+    return _both(60)
 
 
 def _same_answer(checked, rerun):
@@ -95,3 +97,18 @@ def test_a_failed_end_state_falls_back_to_following_the_path(monkeypatch, confir
     assert not _stages(r, "end state")
     assert [p["load_factor"] for p in _stages(r, "path step")] == [
         p["load_factor"] for p in _stages(rerun, "path step")]
+
+
+def test_no_end_state_check_where_the_path_ended_at_a_load_target():
+    """until_load_factor reached before the probe's target (the default scene at 60 elements,
+    stopped at 0.97 × its load at w_top_mid = −8 mm): the end state is not at the probe target,
+    and continuing it there would check another state (without the guard: checks at 880.2 for a
+    path ending at 853.8); auto reruns the path instead."""
+    scene = load_scene(C1.parent / "default.toml")
+    probe_end = run(scene, elements=60).solution.final_load_factor
+    scene = dataclasses.replace(scene, analysis=dataclasses.replace(
+        scene.analysis, until_load_factor=0.97 * probe_end))
+    r = run(scene, elements=60)
+    assert r.solution.final_load_factor == pytest.approx(0.97 * probe_end, rel=1e-6)
+    assert not _stages(r, "end state")
+    assert len(_stages(r, "path step")) >= 2  # it still rechecks, by reruns
