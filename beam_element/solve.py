@@ -312,7 +312,7 @@ def run(
                                   "load_factor": last.load_factor, "reached": converged,
                                   "estimate": choice.estimate if previous is not None else None})
             tol, top = float(bm.tolerance), int(bm.max_core_level)
-            if not converged or not np.any(choice.levels < top) or raises == CORE_RECHECKS or (
+            if not converged or not np.any(choice.levels < top) or raises >= CORE_RECHECKS or (
                     choice.estimate is not None and previous is not None
                     and choice.estimate <= tol):
                 break
@@ -451,7 +451,7 @@ def _check_end_states(
                        "load_factor": state.load_factor, "reached": True,
                        "estimate": estimate, "iterations": state.iterations})
         found = (levels, previous, raises, state.load_factor)
-        if estimate <= tol or not np.any(levels < top) or raises == CORE_RECHECKS:
+        if estimate <= tol or not np.any(levels < top) or raises >= CORE_RECHECKS:
             return found
         higher = _raised_levels(scene, elements, options, up, state, levels, top)
         if higher is None:
