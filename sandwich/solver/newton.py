@@ -17,7 +17,8 @@ round-off floor"): the tolerance is fixed for the whole path while the round-off
 structure grows along it (the 2D cantilevers c3/c4 stalled that way, docs/reference2d.md).
 
 Line search (``backtracks`` > 0, off by default): a correction that does not lower ``‖R‖`` is
-halved, up to ``backtracks`` times; if none lowers it the corrector fails there. For a start far
+halved, up to ``backtracks`` times; if none lowers it the corrector fails there (not once ‖R‖
+is within the tolerance: that correction only settles the increment test). For a start far
 from equilibrium — a converged state carried into a refined model, whose full corrections
 overshoot into the buckled face's other shape (fig. 5's end state: the undamped iteration's
 residual grows by 1e4) — the damped iterates descend until the quadratic phase takes over with
@@ -183,7 +184,9 @@ def newton_correct(
             du = du_r + dlam * du_f
             if not math.isfinite(dot(du, du)):
                 return fail("non-finite correction", it)
-            if settings.backtracks > 0:
+            if settings.backtracks > 0 and r_norm > settings.tol * scale:
+                # (at the tolerance already a correction only settles the increment test, and
+                # round-off may keep it from lowering ‖R‖: taken in full)
                 searched = _backtrack(system, u, lam, du, dlam, r_norm, settings.backtracks,
                                       norm, f_ref)
                 if searched is None:

@@ -16,7 +16,7 @@ import pytest
 from solver_toys import ToySystem
 
 from sandwich.solver import NewtonSettings, newton_correct
-from sandwich.solver.controls import ProbeConstraint
+from sandwich.solver.controls import LoadConstraint, ProbeConstraint
 
 
 class AtanSpring(ToySystem):
@@ -62,3 +62,32 @@ def test_backtracking_leaves_a_start_plain_newton_handles_unchanged():
     assert plain.iterations == damped.iterations
     np.testing.assert_array_equal(plain.u, damped.u)
     assert s1.evaluations == s0.evaluations  # the line search's force is reused, not redone
+
+
+class NoisySpring(ToySystem):
+    """f = k u plus a force error of amplitude δ that changes from call to call (round-off)."""
+
+    dof_names = ("u",)
+
+    def __init__(self, delta: float, k: float = 3.0) -> None:
+        super().__init__()
+        self.delta, self.k = delta, k
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        self.evaluations += 1
+        return self.k * u + self.delta * math.sin(1.1 * self.evaluations)
+
+    def tangent(self, u: np.ndarray) -> np.ndarray:
+        return np.array([[self.k]])
+
+
+def test_a_residual_within_the_tolerance_is_not_line_searched():
+    """Closed form u = λ P / k within δ / k. After the first correction ‖R‖ is at the noise δ,
+    below tol · λ P, but the increment test needs one more (tiny) correction; whether it
+    lowers ‖R‖ is up to the noise (with this noise it does not: searched, the corrector would
+    fail with "no decrease"), so it is taken in full."""
+    system = NoisySpring(delta=1e-9)
+    res = newton_correct(system, np.array([0.0]), 1.0, LoadConstraint(1.0),
+                         NewtonSettings(tol=1e-8, max_iterations=10, backtracks=12))
+    assert res.converged, res.reason
+    assert res.u[0] == pytest.approx(1.0 / 3.0, abs=2e-9)
