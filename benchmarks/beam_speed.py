@@ -220,8 +220,8 @@ def fig5_speed(repeat, with_2d):
         "fig. 5 full path (paper-fig5-top-debond-40-load-top to w_top_mid = -15 mm, arc-length, "
         "240 elements, the scene's element choices — stretch faces, averaged face membrane, "
         "closest-point contact): with the paper's core (`[beam_model] core = 1`) and as "
-        "shipped (`core = \"auto\"`: core levels chosen and checked by up to three passes of "
-        "the path).",
+        "shipped (`core = \"auto\"`: core levels chosen and checked by passes of the path and "
+        "end-state checks; fig. 5: two passes, two checks).",
         "",
         f"2 cores: {before} before, {after} after (this benchmark's own runs included; "
         "other jobs, if any, inflate the times). Times are best of the runs.",
