@@ -474,6 +474,7 @@ def _end_state(
     """
     from sandwich.solver.controls import ProbeConstraint
     from sandwich.solver.newton import NewtonSettings, newton_correct
+    from sandwich.solver.system import inner_product
 
     a = scene.analysis
     up = build_model(scene, elements=elements, gauss=_gauss_orders(scene),
@@ -483,12 +484,10 @@ def _end_state(
                               force_floor=float(np.linalg.norm(up.f_ref)) * abs(state.load_factor),
                               backtracks=END_STATE_BACKTRACKS)
     res = newton_correct(up, transfer(state.u, model, up), state.load_factor,
-                         ProbeConstraint(c, float(a.until_value), lambda x, y: float(x @ y)),
-                         settings)
+                         ProbeConstraint(c, float(a.until_value), inner_product(up)), settings)
     if not res.converged or res.load_factor == 0.0:
         return None
-    if _max_penetration(up, [ConvergedState(0, res.load_factor, res.u, 0, {})]) > \
-            up.penetration_bound():
+    if _max_penetration(up, [res.u]) > up.penetration_bound():
         return None
     probes = {n: float(np.asarray(up.probe_vector(n)) @ res.u) for n in up.probe_rows}
     return up, ConvergedState(state.step, float(res.load_factor), res.u, res.iterations, probes)
@@ -613,7 +612,7 @@ def _follow_penalised(
     model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
     while True:
         states, message, converged, limit_points = _follow(model, scene, progress, max_steps)
-        pen, bound = _max_penetration(model, states), model.penetration_bound()
+        pen, bound = _max_penetration(model, [s.u for s in states]), model.penetration_bound()
         if pen <= bound or len(raised) == PENALTY_RESTARTS:
             return model, states, message, converged, limit_points, raised
         raised.append(model.penalty)
@@ -639,10 +638,10 @@ def _follow(
     return states, result.message, result.reached_target, list(result.limit_points)
 
 
-def _max_penetration(model: BeamModel, states: list[ConvergedState]) -> float:
-    """Deepest contact penetration (mm) over the converged states."""
-    return max((c.max_penetration for s in states for c in model.contact_summary(s.u).values()),
-               default=0.0)
+def _max_penetration(model: BeamModel, displacements: list[np.ndarray]) -> float:
+    """Deepest contact penetration (mm) over states given by their free DOFs."""
+    return max((c.max_penetration for u in displacements
+                for c in model.contact_summary(u).values()), default=0.0)
 
 
 def solve(scene: Scene, progress: Callable[[object], None] | None = None) -> Solution:
