@@ -69,6 +69,12 @@ END_STATE_CHECKS = True
 END_STATE_MATCH = 1e-5  # relative: the pass at the checked levels must end at the check's load
 END_STATE_ITERATIONS = 40
 END_STATE_BACKTRACKS = 20
+# A check whose change δ is at most BELOW_FRACTION × the tolerance says the levels below it are
+# within the tolerance themselves (their error ≤ δ / (1 − ρ) ≤ 2δ while each raise at least halves
+# the error, ρ ≤ ½: measured on the shipped paths, docs/beam_element.md): those levels are
+# reported, with the estimate BELOW_FACTOR × δ, and the path at the raised ones is not followed.
+BELOW_FRACTION = 0.25
+BELOW_FACTOR = 2.0
 
 
 @dataclass(frozen=True)
@@ -265,6 +271,7 @@ def run(
         raises = 0
         checks = END_STATE_CHECKS and a.until_probe is not None
         pending: tuple | None = None  # the end-state check this pass must confirm
+        bound: float | None = None  # the estimate of the levels below a check within BELOW_…
         while True:
             budget = None if kept is None else min(
                 int(a.max_steps), max(RERUN_MIN_STEPS, RERUN_STEP_FACTOR * (len(kept[0][1]) - 1)))
@@ -283,7 +290,7 @@ def run(
                     # equilibrium at the same deflection: fig. 6, fig. 4's rerun stopping short):
                     # the checks are not the paths' ends here. From the pass they started at,
                     # follow the path after every raise, as without them.
-                    checks = False
+                    checks, bound = False, None
                     kept, first, previous, raises = start
                     if not np.array_equal(first, choice.levels):
                         choice.passes.append({"stage": f"path step {last.step}",
@@ -306,6 +313,8 @@ def run(
             if previous is not None:  # the change the last raise made is the estimate
                 choice.estimate = (abs(last.load_factor - previous) / abs(last.load_factor)
                                    if converged else None)
+            if bound is not None:  # confirmed: these are the levels below a check within it
+                choice.estimate = bound
             choice.passes.append({"stage": f"path step {last.step}",
                                   "elements_per_level": level_counts(choice.levels),
                                   "load_factor": last.load_factor, "reached": converged,
@@ -329,16 +338,21 @@ def run(
                 # confirms it, else the checks are dropped), a raise that proves too small
                 # costs one Newton solve instead of a path.
                 start = (kept, levels, previous, raises)
-                found, complete = _check_end_states(scene, elements, options, model, last,
-                                                    levels, previous, raises, tol, top,
-                                                    choice.passes)
+                found, complete, below = _check_end_states(scene, elements, options, model,
+                                                           last, levels, previous, raises, tol,
+                                                           top, choice.passes)
                 # A check that does not converge says the raised path ends far from the checked
                 # one (c2: 736.8 → 268.3); the later raises' checks failed as well on every
                 # shipped scene (c2, fig. 4), so none is tried after it.
                 checks = complete
+                if below is not None and found is None:
+                    # this pass's own levels are within the tolerance: it is the answer
+                    choice.levels, choice.estimate = kept[1], below
+                    break
                 if found is not None:
                     choice.levels, previous, raises, checked_load = found
                     pending = (checked_load, start)
+                    bound = below
             if progress is not None:
                 progress(CoreRecheck(level_counts(choice.levels)))
         if stopped_rerun:
@@ -428,7 +442,7 @@ def _check_end_states(
     scene: object, elements: int | None, options: dict, model: BeamModel,
     last: ConvergedState, levels: np.ndarray, previous: float, raises: int, tol: float,
     top: int, passes: list[dict],
-) -> tuple[tuple[np.ndarray, float, int, float] | None, bool]:
+) -> tuple[tuple[np.ndarray, float, int, float] | None, bool, float | None]:
     """Raise on end states alone while the change they show exceeds ``tol``.
 
     From ``last`` (the end of the pass at the levels below ``levels``, end load ``previous``),
@@ -436,27 +450,33 @@ def _check_end_states(
     change exceeds ``tol`` (and raises remain, the zones are not at the cap) the levels are
     raised again from it. Returns the levels of the last check that converged, the end load at
     the levels below them, the raises count and the check's end load — the pass that follows
-    must end there — or None if the first check fails; and whether no check failed. Each check
-    is listed in ``passes``.
+    must end there — or None if the first check fails; whether no check failed; and, where the
+    last check's change δ is at most ``BELOW_FRACTION × tol``, the estimate ``BELOW_FACTOR × δ``
+    of the levels below it, which are then the ones returned (None: the checked pass's own
+    levels, no path to follow). Each check is listed in ``passes``.
     """
     found = None
     cur, state = model, last
     while True:
         checked = _end_state(scene, elements, options, cur, state, levels)
         if checked is None:
-            return found, False
+            return found, False, None
         up, state = checked
         estimate = abs(state.load_factor - previous) / abs(state.load_factor)
-        passes.append({"stage": f"end state at step {last.step}",
-                       "elements_per_level": level_counts(levels),
-                       "load_factor": state.load_factor, "reached": True,
-                       "estimate": estimate, "iterations": state.iterations})
+        entry = {"stage": f"end state at step {last.step}",
+                 "elements_per_level": level_counts(levels),
+                 "load_factor": state.load_factor, "reached": True,
+                 "estimate": estimate, "iterations": state.iterations}
+        passes.append(entry)
+        if estimate <= BELOW_FRACTION * tol:
+            entry["levels_below_reported"] = True
+            return found, True, BELOW_FACTOR * estimate
         found = (levels, previous, raises, state.load_factor)
         if estimate <= tol or not np.any(levels < top) or raises >= CORE_RECHECKS:
-            return found, True
+            return found, True, None
         higher = _raised_levels(scene, elements, options, up, state, levels, top)
         if higher is None:
-            return found, True
+            return found, True, None
         cur, previous, levels, raises = up, state.load_factor, higher, raises + 1
 
 
