@@ -286,7 +286,7 @@ class BeamModel:
         fac = factorize_envelope(K, structure)
         widened = getattr(fac, "structure", structure)
         if (widened is not structure and widened.matches(K)
-                and widened is not structure.__dict__.get("_natural")):  # not the retry's
+                and widened is not structure.kept_natural):  # not the natural-order retry's
             known[known.index(structure)] = widened
         return fac
 

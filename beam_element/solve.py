@@ -70,9 +70,9 @@ END_STATE_MATCH = 1e-5  # relative: the pass at the checked levels must end at t
 END_STATE_ITERATIONS = 40
 END_STATE_BACKTRACKS = 20
 # A check whose change δ is at most BELOW_FRACTION × the tolerance says the levels below it are
-# within the tolerance themselves (their error ≤ δ / (1 − ρ) ≤ 2δ while each raise at least halves
-# the error, ρ ≤ ½: measured on the shipped paths, docs/beam_element.md): those levels are
-# reported, with the estimate BELOW_FACTOR × δ, and the path at the raised ones is not followed.
+# within the tolerance themselves: those levels are reported, with the estimate BELOW_FACTOR × δ
+# (≈ δ / (1 − ρ) for a raise that halves the error, ρ = ½ — an estimate, not a bound: what it
+# reads against level 4: docs/beam_element.md), and the path at the raised ones is not followed.
 BELOW_FRACTION = 0.25
 BELOW_FACTOR = 2.0
 
@@ -271,7 +271,7 @@ def run(
         raises = 0
         checks = END_STATE_CHECKS and a.until_probe is not None
         pending: tuple | None = None  # the end-state check this pass must confirm
-        bound: float | None = None  # the estimate of the levels below a check within BELOW_…
+        below_estimate: float | None = None  # of the levels below a check within BELOW_…
         while True:
             budget = None if kept is None else min(
                 int(a.max_steps), max(RERUN_MIN_STEPS, RERUN_STEP_FACTOR * (len(kept[0][1]) - 1)))
@@ -290,7 +290,7 @@ def run(
                     # equilibrium at the same deflection: fig. 6, fig. 4's rerun stopping short):
                     # the checks are not the paths' ends here. From the pass they started at,
                     # follow the path after every raise, as without them.
-                    checks, bound = False, None
+                    checks, below_estimate = False, None
                     kept, first, previous, raises = start
                     if not np.array_equal(first, choice.levels):
                         choice.passes.append({"stage": f"path step {last.step}",
@@ -313,8 +313,8 @@ def run(
             if previous is not None:  # the change the last raise made is the estimate
                 choice.estimate = (abs(last.load_factor - previous) / abs(last.load_factor)
                                    if converged else None)
-            if bound is not None:  # confirmed: these are the levels below a check within it
-                choice.estimate = bound
+            if below_estimate is not None:  # confirmed: the levels below a check within it
+                choice.estimate = below_estimate
             choice.passes.append({"stage": f"path step {last.step}",
                                   "elements_per_level": level_counts(choice.levels),
                                   "load_factor": last.load_factor, "reached": converged,
@@ -352,7 +352,7 @@ def run(
                 if found is not None:
                     choice.levels, previous, raises, checked_load = found
                     pending = (checked_load, start)
-                    bound = below
+                    below_estimate = below
             if progress is not None:
                 progress(CoreRecheck(level_counts(choice.levels)))
         if stopped_rerun:

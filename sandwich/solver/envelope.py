@@ -224,6 +224,11 @@ class EnvelopeStructure:
         self.__dict__["_natural_first"] = preferred
 
     @property
+    def kept_natural(self) -> EnvelopeStructure | None:
+        """The natural-order variant kept by :meth:`keep_natural` (None before any)."""
+        return self.__dict__.get("_natural")
+
+    @property
     def natural_first(self) -> bool:
         """Whether :func:`factorize_envelope` tries the natural-order variant first."""
         return bool(self.__dict__.get("_natural_first", False))
