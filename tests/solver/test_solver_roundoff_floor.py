@@ -51,3 +51,36 @@ def test_an_exact_system_converges_ordinarily():
     """Ordinary convergence is still reported as such when the tolerance can be met."""
     res = solve_equilibrium(NoisySpring(0.0, declare=True), 1.0, settings=NewtonSettings())
     assert res.converged and res.reason == "converged"
+
+
+class SlowSpring(ToySystem):
+    """f = k u with a tangent 2k: Newton converges linearly (ratio ½), so many corrections
+    pass the increment test before the residual one; the floor evaluations are counted."""
+
+    dof_names = ("u",)
+
+    def __init__(self, k: float = 3.0) -> None:
+        super().__init__()
+        self.k, self.floors = k, 0
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        return self.k * u
+
+    def tangent(self, u: np.ndarray) -> np.ndarray:
+        return np.array([[2.0 * self.k]])
+
+    def residual_roundoff(self, u: np.ndarray) -> float:
+        self.floors += 1
+        return 1e-300
+
+
+def test_the_floor_is_evaluated_once_per_corrector():
+    """Linear convergence from u = 0: tol 1e-10 passes the increment test (√tol) after ~17
+    corrections and the residual test after ~33; the floor, asked for at each of the ~16 in
+    between before, is evaluated once, and the answer is the closed form λ / k."""
+    system = SlowSpring()
+    res = solve_equilibrium(system, 1.0, settings=NewtonSettings(tol=1e-10, max_iterations=60))
+    assert res.converged and res.reason == "converged"
+    assert abs(res.u[0] - 1.0 / system.k) <= 1e-9 / system.k
+    assert res.iterations > 20  # the premise: many corrections after the increment test passed
+    assert system.floors == 1
