@@ -32,7 +32,8 @@ load level). Three parts:
 
 3. **Nonlinear, at the map's settings** (240 graded elements): the beam reaches the target at
    the edges (the cheap ones in the default suite, debond 0.9 span and load ×2 ``heavy``; load ×2
-   is a strict xfail: its path retraces at the load maximum, see docs/extremes.md); and
+   was a strict xfail until 2026-12-04, its path retracing at a load maximum, docs/extremes.md
+   point 7); and
    (``heavy``) beam and 2D reference at level coarse, both run here, on the edge cases the map
    found in agreement: the load curves must agree within the class the map put them in (3 % or
    10 % relative L2 over the common range). Reference: the 2D model.
@@ -192,11 +193,9 @@ def test_beam_agrees_with_2d_at_the_edges_of_the_map(sweep, value, tol, common):
 MAP_CONVERGED_EDGES = [  # cheap at 240 elements (~1-2 s each unloaded): default suite
     ("stiffness", 1e-5), ("thickness", 100), ("slenderness", 20),
     pytest.param("debond", 0.9, marks=pytest.mark.heavy),  # 255 steps
-    pytest.param("load", 2.0, marks=[pytest.mark.heavy, pytest.mark.xfail(strict=True, reason=(
-        "at 240 elements the path reaches a load maximum (λ ≈ 2047, w ≈ −27.3 mm) next to a "
-        "bifurcation (negative pivots 1 → 2 → 3) and runs back near the loading branch; going "
-        "on to −30 mm needs branch switching, which the follower does not do; docs/extremes.md "
-        "point 7"))]),
+    # load ×2: was a strict xfail (the path retraced at a load maximum); it goes forward to −30 mm
+    # since the probe rescue and the current element defaults (docs/extremes.md point 7)
+    pytest.param("load", 2.0, marks=pytest.mark.heavy),
 ]
 
 
