@@ -266,8 +266,9 @@ class EnvelopeStructure:
             # one matters where the first matrix left DOFs uncoupled (open contact pairs over
             # a debond: RCM put them at one end, and the union in that order spans the matrix)
             candidates = [(widen.ordering, widen.order)]
-            if not fixed:
-                candidates += [("natural", np.arange(n)), ("rcm", None)]
+            if not fixed:  # (a fresh natural order is the old one if that was natural)
+                candidates += [("natural", np.arange(n))] if widen.ordering != "natural" else []
+                candidates.append(("rcm", None))
         elif n > 1 and ordering != "natural":
             candidates.append(("rcm", None))
         best = None
