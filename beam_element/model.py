@@ -334,6 +334,30 @@ class BeamModel:
             raise ValueError(f"expected a vector of {self.size} free DOFs, got shape {u.shape}")
         return self.dof_map.expand(u)
 
+    def internal_force_nearby(self, u: np.ndarray) -> np.ndarray:
+        """f_int(u) for an iterate within a converged increment of the last evaluated one.
+
+        The force is exactly :meth:`internal_force`'s (the layers' force-only kernels give it
+        bit for bit). The tangent :meth:`tangent` then returns at ``u`` keeps the layers' part
+        of the last evaluation and re-evaluates the contact law: the last matrix's contact
+        terms are taken out of its values in place and this u's put in (no copy of the
+        matrix). A step the corrector's increment test has passed moves the state by ≲ 1e-4
+        of its increment, by ≈ 1e-7 where the contact pairs settle in the law's knee
+        (:mod:`sandwich.solver.newton`): the layers' tangent does not change measurably over
+        it, the contact law's stiffness changes by factors of e. Where the last evaluation
+        kept no contact terms (the NumPy path, a grown pattern) this is a full evaluation.
+        """
+        cache = self._cache
+        kernels = _kernels() if self.use_kernels else None
+        last = cache[3] if cache is not None else None
+        if (kernels is None or not isinstance(last, _Assembled) or last.terms is None
+                or last.terms[0] is not self.pattern or np.array_equal(cache[0], u)):
+            return self._evaluate(u, tangent=False)[0]
+        f_full, assembled = self._compiled_forces(self.expand(u), kernels, nearby=last)
+        f = self.dof_map.reduce(f_full)
+        self._cache = (np.array(u, dtype=float, copy=True), f, assembled.K, assembled)
+        return f
+
     def _evaluate(self, u: np.ndarray, tangent: bool) -> tuple[np.ndarray, sp.csr_matrix | None]:
         cache = self._cache
         if cache is not None and np.array_equal(cache[0], u):
@@ -391,19 +415,42 @@ class BeamModel:
         return scatter_vector(u_full.size, self.block_dofs, forces), states
 
     def _compiled_forces(
-        self, u_full: np.ndarray, kernels: object
+        self, u_full: np.ndarray, kernels: object, nearby: _Assembled | None = None
     ) -> tuple[np.ndarray, _Assembled]:
         """Force and reduced tangent in one pass: layers by the kernels, contact compact.
 
         A closest-point pair whose chosen segment the pattern lacks grows it
-        (:meth:`_grow_pattern`) and the pass is made again on the grown pattern.
+        (:meth:`_grow_pattern`) and the pass is made again on the grown pattern (in full).
+        With ``nearby`` (the last evaluation, :meth:`internal_force_nearby`) the layers give
+        their force only and the tangent is ``nearby``'s values with its contact terms
+        replaced by this u's; ``nearby`` is spent (its matrix is this one).
         """
         pattern = self.pattern  # block families: _families(), then the contact pairs
-        data = np.zeros(pattern.indices.size)
         lengths = self.mesh.lengths
         forces = []
+        terms = []
         force_dofs = list(self.block_dofs)  # a closest-point group's force: on its 10 DOFs
         families = self._families()
+        if nearby is not None:
+            data = nearby.K.data  # taken over: the last contact terms out, the new ones in
+            for kind, a, b, c in nearby.terms[1]:
+                if kind == "compact":
+                    kernels.scatter_compact(a, b, -c, pattern.indptr, pattern.indices, data)
+                else:
+                    kernels.scatter_blocks(-c, *pattern.slots_of(a), data)
+            nearby.terms = None
+            for op, _, els, dofs in families:
+                if kernels.supports(op):
+                    forces.append(kernels.layer_blocks(op, u_full[dofs], lengths[els],
+                                                       self.width, False)[0])
+                    continue
+                u_e = np.zeros((els.size, int(op.dofs.max()) + 1))
+                u_e[:, op.dofs] = u_full[dofs]
+                forces.append(layer_state(op, u_e, lengths[els], self.width).f)
+            kept, families = len(families), []  # the layers' tangent: nearby's
+        else:
+            kept = 0
+            data = np.zeros(pattern.indices.size)
         for i, (op, products, els, dofs) in enumerate(families):
             if kernels.supports(op):
                 forces.append(kernels.layer_assemble(op, u_full[dofs], lengths[els], self.width,
@@ -415,7 +462,7 @@ class BeamModel:
             forces.append(st.f)
             kernels.scatter_blocks(layer_tangent(op, st, products), *pattern.slots_of(i), data)
         contact = []
-        for j, pairs in enumerate(self.pairs, start=len(families)):
+        for j, pairs in enumerate(self.pairs, start=len(families) + kept):
             if pairs.search == "closest-point":  # on each pair's chosen segment only
                 f10, K10, p, k, cols = compact_response(pairs, u_full, self.penalty,
                                                         self.smoothing)
@@ -425,18 +472,23 @@ class BeamModel:
                 contact.append((p, k))
                 free = np.ascontiguousarray(self.dof_map.free[dofs10], dtype=np.int64)
                 sign = np.where(free >= 0, self.dof_map.sign[dofs10], 0).astype(np.int8)
-                if kernels.scatter_compact(free, sign, np.ascontiguousarray(K10),
+                K10 = np.ascontiguousarray(K10)
+                if kernels.scatter_compact(free, sign, K10,
                                            pattern.indptr, pattern.indices, data):
                     self._grow_pattern(_segments_around(pairs, cols))
                     return self._compiled_forces(u_full, kernels)
+                terms.append(("compact", free, sign, K10))
                 continue
             f, K, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(f)
             contact.append((p, k))
-            kernels.scatter_blocks(np.ascontiguousarray(K), *pattern.slots_of(j), data)
+            K = np.ascontiguousarray(K)
+            kernels.scatter_blocks(K, *pattern.slots_of(j), data)
+            terms.append(("blocks", j, None, K))
         n = self.pattern.n
         K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
-        return scatter_vector(u_full.size, force_dofs, forces), _Assembled(K, contact)
+        assembled = _Assembled(K, contact, (pattern, terms))
+        return scatter_vector(u_full.size, force_dofs, forces), assembled
 
     def _tangent_blocks(
         self, u_full: np.ndarray, states: list[list[LayerState]]
@@ -550,7 +602,7 @@ def _seed_dofs(pairs: ContactPairs) -> np.ndarray:
     return pairs.support_dofs[:, cols]
 
 
-@dataclass(frozen=True)
+@dataclass(eq=False)
 class _Assembled:
     """What the compiled path keeps of a force evaluation at its u.
 
@@ -560,6 +612,8 @@ class _Assembled:
 
     K: sp.csr_matrix
     contact: list = field(default_factory=list)
+    # (pattern, contact terms added into K) for BeamModel.internal_force_nearby; None once spent
+    terms: tuple | None = None
 
 
 _KERNELS: list = []

@@ -16,6 +16,13 @@ state of the model, else the reason (e.g. an element turned inside out, det F â‰
 solver rejects a converged step whose state is inadmissible (the step is cut), so it never
 follows the model's equations into a region where they have no physical meaning (the
 St. Venantâ€“Kirchhoff law, for one, has equilibrium states with inverted elements).
+
+A system may also provide ``internal_force_nearby(u)``: f_int(u), exactly as
+``internal_force(u)``, for an iterate within a converged increment of the last one evaluated
+(the corrector's increment test passed); the tangent that ``tangent(u)`` then returns may keep
+the parts the system knows such a step cannot change measurably and re-evaluate only the rest
+(the beam keeps its layers' tangent and re-evaluates the contact law, whose knee is what such
+iterations still resolve: :mod:`sandwich.solver.newton`).
 """
 
 from __future__ import annotations
