@@ -159,7 +159,18 @@ def test_aot_build_equals_the_jit_bit_for_bit_without_importing_numba(tmp_path):
     assert said_jit == ["jit", "True"]
     assert sorted(aot.files) == sorted(ref.files)
     for name in ref.files:
-        assert np.array_equal(aot[name], ref[name]), name
+        # Bit for bit on the Intel machines the build was written on; on AMD EPYC (2026-12-04)
+        # level 2's kernels and the path differ at round-off (≤ 3e-15 of each array's largest
+        # entry: the JIT compiles for the host CPU, the build for a generic x86-64, and LLVM
+        # contracts multiply-adds differently), and the solves by that round-off times the
+        # tangent's conditioning (x1: 1.2e-13 with f1 and K1 identical bit for bit). Same
+        # computation: kernels compared at round-off, solves at κ ε, pivot counts exactly.
+        scale = float(np.max(np.abs(ref[name]), initial=0.0))
+        rtol = 1e-10 if name.startswith("x") else 1e-13
+        assert aot[name].shape == ref[name].shape, name
+        assert np.max(np.abs(aot[name] - ref[name]), initial=0.0) <= rtol * scale, name
+        if name.startswith("neg"):
+            assert np.array_equal(aot[name], ref[name]), name
     assert ref["path"].shape[0] > 5 and np.all(np.isfinite(ref["path"]))
 
 
