@@ -24,6 +24,10 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
 - a model may add history columns to every accepted state (optional ``system.state_columns(u)``
   returning ``{name: value or None}``, kept in :attr:`PathState.extra`): a caller that
   streams the states (an interrupted run) then has them without the model's post-processing;
+- a step's corrector gives up early once its residual has risen twice in a row above its first
+  one (``DIVERGENCE_RISES``): the step is cut, and its retries run without that test (an
+  iteration hunting for its contact set may rise so and still converge); once a corrector has
+  converged after rising so, the test is off for the rest of the path;
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
   (it never grows after a cut step) and is clipped to [min_increment, max_increment].
@@ -34,6 +38,7 @@ so in the linear range the λ and u parts of the arc weigh the same.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass, field
@@ -43,7 +48,7 @@ import numpy as np
 from sandwich.results import LimitPoint
 from sandwich.solver.controls import ArcLengthConstraint, LoadConstraint, ProbeConstraint
 from sandwich.solver.limits import find_limit_points
-from sandwich.solver.newton import RECOVERABLE_ERRORS, NewtonSettings, newton_correct
+from sandwich.solver.newton import RECOVERABLE_ERRORS, RISING, NewtonSettings, newton_correct
 from sandwich.solver.system import DiscreteSystem, Factorization, inner_product
 
 __all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linear"]
@@ -54,6 +59,11 @@ RETRACE = "the step turns back"  # prefix of the reason of a step rejected by th
 TARGET_SUBSTEP_CUTS = 6  # halvings of the sub-increment when a crossed target is hit directly
 RESCUE_FRACTION = 0.05  # probe rescue: tried once the arc is cut below this × its largest so far
 RESCUE_MEMORY = 5  # accepted steps remembered for the rescue step's probe change
+#: The corrector's rising test (``NewtonSettings.divergence_rises``) on a step's attempts until
+#: one fails by it; the retries of that step, the target's and the rescue's correctors run without,
+#: and the rest of the path once a corrector converged after rising so (docs/beam_speed.md,
+#: "Corrector attempts that diverge").
+DIVERGENCE_RISES = 2
 
 
 @dataclass
@@ -198,6 +208,7 @@ class _Trial:
     load_factor: float
     iterations: int
     factorization: Factorization
+    rises: int = 0  # the corrector's longest run of rises above its first residual
 
 
 def _fmt_probes(probes: dict[str, float]) -> str:
@@ -346,6 +357,7 @@ class _Follower:
             self.sigma = math.copysign(1.0, ct * self.lam_est) if ct != 0.0 else 1.0
         self.newton = NewtonSettings(tol=opt.tol, max_iterations=opt.max_iterations,
                                      psi=self.psi)
+        self.divergence_rises = DIVERGENCE_RISES  # off once a corrector that rose so converged
 
         while len(self.states) - 1 < opt.max_steps:
             last = self.states[-1]
@@ -393,13 +405,20 @@ class _Follower:
         opt = self.opt
         cuts = 0
         rescued = False
+        rises = self.divergence_rises  # the corrector's rising test, until it has cut this step
         while True:
             h_try, direct, sign = self._clip_to_target(size.h, last)
             if sign is not None:  # towards a directly controlled target
                 self.sigma = sign
-            trial, reason = self._attempt(h_try, last, t)
+            trial, reason = self._attempt(h_try, last, t, rises)
             if trial is not None:
+                if 0 < DIVERGENCE_RISES <= trial.rises:
+                    # a corrector that rose so converged: this model's iterations hunt (a contact
+                    # set) and still converge; the test would shrink its steps, off for the path
+                    self.divergence_rises = 0
                 return trial, h_try, direct, cuts
+            if reason.startswith(RISING):
+                rises = 0
             size.h = 0.5 * h_try
             cuts += 1
             if not rescued and self._rescue_due(cuts, size.h):
@@ -503,8 +522,13 @@ class _Follower:
             return math.copysign(1.0, dl) * (-1.0 if flips else 1.0)
         return math.copysign(1.0, dot) if dot != 0.0 else self.sigma
 
-    def _attempt(self, h: float, last: PathState, t: np.ndarray) -> tuple[_Trial | None, str]:
-        """One predictor–corrector step of size ``h`` from ``last``."""
+    def _attempt(self, h: float, last: PathState, t: np.ndarray,
+                 rises: int = 0) -> tuple[_Trial | None, str]:
+        """One predictor–corrector step of size ``h`` from ``last``.
+
+        ``rises``: the corrector's ``divergence_rises`` (0: off, as for the target's and the
+        rescue's correctors, whose failure ends their search).
+        """
         opt = self.opt
         if opt.control == "load":
             target = (opt.until_load_factor if opt.until_load_factor is not None
@@ -533,7 +557,7 @@ class _Follower:
             if pred_len > opt.max_predictor_growth * prev_len:
                 return None, (f"predictor {pred_len:.3g} longer than {opt.max_predictor_growth}"
                               f" × the previous step {prev_len:.3g}")
-        settings = self._newton_settings()
+        settings = dataclasses.replace(self._newton_settings(), divergence_rises=rises)
         res = newton_correct(self.system, last.u + du_pred, last.load_factor + dlam, constraint,
                              settings, last.u, last.load_factor)
         if not res.converged or res.factorization is None:
@@ -549,7 +573,8 @@ class _Follower:
             why = self.admissible(res.u)
             if why:
                 return None, f"{INADMISSIBLE}: {why}"
-        return _Trial(res.u, res.load_factor, res.iterations, res.factorization), "converged"
+        return _Trial(res.u, res.load_factor, res.iterations, res.factorization,
+                      res.rises), "converged"
 
     def _newton_settings(self) -> NewtonSettings:
         """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far."""
