@@ -38,7 +38,6 @@ so in the linear range the λ and u parts of the arc weigh the same.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass, field
@@ -557,7 +556,7 @@ class _Follower:
             if pred_len > opt.max_predictor_growth * prev_len:
                 return None, (f"predictor {pred_len:.3g} longer than {opt.max_predictor_growth}"
                               f" × the previous step {prev_len:.3g}")
-        settings = dataclasses.replace(self._newton_settings(), divergence_rises=rises)
+        settings = self._newton_settings(rises)
         res = newton_correct(self.system, last.u + du_pred, last.load_factor + dlam, constraint,
                              settings, last.u, last.load_factor)
         if not res.converged or res.factorization is None:
@@ -576,12 +575,15 @@ class _Follower:
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization,
                       res.rises), "converged"
 
-    def _newton_settings(self) -> NewtonSettings:
-        """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far."""
+    def _newton_settings(self, rises: int = 0) -> NewtonSettings:
+        """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far.
+
+        ``rises``: the rising test's ``divergence_rises`` (0: off).
+        """
         floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
                  * max(abs(s.load_factor) for s in self.states))
         return NewtonSettings(tol=self.opt.tol, max_iterations=self.opt.max_iterations,
-                              psi=self.psi, force_floor=floor)
+                              psi=self.psi, force_floor=floor, divergence_rises=rises)
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
