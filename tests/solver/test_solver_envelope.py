@@ -53,6 +53,65 @@ def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeyp
         assert np.allclose(fac.solve(b[:, c]), x[:, c], rtol=0, atol=1e-14 * np.abs(x).max())
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_panels_give_the_inertia_and_solves_of_dense_lapack(seed, monkeypatch):
+    """The panel kernel (column storage wider than PANEL_MIN_WIDTH): negative pivots against
+    eigvalsh, solves against the dense matrix, on random indefinite bands whose size is not a
+    multiple of the panel (a last, narrower panel) and whose widths vary (zero-padded panel
+    columns); and the same factors as the column kernel to round-off."""
+    rng = np.random.default_rng(100 + seed)
+    n = 8 * int(rng.integers(11, 28)) + int(rng.integers(1, 8))  # a last, narrower panel
+    widths = rng.integers(40, 70, size=n)
+    widths[rng.integers(0, n, size=5)] = rng.integers(0, 5, size=5)  # a few narrow rows
+    A = _variable_band(rng, n, widths)
+    A.sort_indices()
+    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)  # column storage
+    s = EnvelopeStructure.of(A)
+    assert s.storage == "columns" and s.panels and s.n % envelope.PANEL
+    eig = np.linalg.eigvalsh(A.toarray())
+    fac = factorize_envelope(A, s)
+    assert isinstance(fac, EnvelopeFactorization)
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+    b = rng.normal(size=(n, 2))
+    cond = np.abs(eig).max() / np.abs(eig).min()
+    assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
+    # backward error of the factors (Higham, Thm 10.3 for LDLᵀ without pivoting):
+    # |P K Pᵀ − L D Lᵀ| ≤ γ_n |L| |D| |Lᵀ| entry by entry, γ_n = n u / (1 − n u)
+    L, D = _column_factors(fac)
+    K = A.toarray()[np.ix_(s.order, s.order)]
+    gamma = n * np.finfo(float).eps / 2 / (1 - n * np.finfo(float).eps / 2)
+    assert np.all(np.abs(K - (L * D) @ L.T) <= gamma * (np.abs(L) * np.abs(D)) @ np.abs(L).T)
+
+
+def _column_factors(fac):
+    """Dense L (unit lower) and D of a column-storage factorisation."""
+    s = fac.structure
+    L, D = np.eye(s.n), np.empty(s.n)
+    for j in range(s.n):
+        col = fac._env[s.colptr[j]:s.colptr[j + 1]]
+        D[j] = col[0]
+        L[j + 1:s.last[j] + 1, j] = col[1:]
+    return L, D
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_panels_on_narrow_bands_too(seed, monkeypatch):
+    """Forced onto the small random envelopes (every width, panels wider than the band)."""
+    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)
+    monkeypatch.setattr(envelope, "PANEL_MIN_WIDTH", -1)
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 40))
+    A = _variable_band(rng, n, rng.integers(0, 12, size=n))
+    A.sort_indices()
+    fac = factorize_envelope(A)
+    assert fac.structure.panels
+    eig = np.linalg.eigvalsh(A.toarray())
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+    b = rng.normal(size=n)
+    cond = np.abs(eig).max() / np.abs(eig).min()
+    assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
+
+
 def test_explicit_zeros_in_wide_rows_are_skipped_with_the_same_answer(monkeypatch):
     """A pattern wider than its values (a contact pair's unchosen segments): same inertia and
     solution as the dense matrix, at the numerical envelope's operation count."""
@@ -321,6 +380,11 @@ def test_refused_in_the_natural_order_goes_straight_to_the_pivoting_lu(monkeypat
 def test_bad_matrices_are_refused():
     with pytest.raises(SingularTangentError):
         factorize_envelope(sp.csr_matrix(np.array([[1.0, np.nan], [np.nan, 1.0]])))
+    for bad in (np.inf, -np.inf, np.nan):  # one value, in a run of the storage
+        A = np.diag(np.arange(1.0, 7.0)) + 0.1 * np.eye(6, k=1) + 0.1 * np.eye(6, k=-1)
+        A[3, 4] = A[4, 3] = bad
+        with pytest.raises(SingularTangentError, match="non-finite"):
+            factorize_envelope(sp.csr_matrix(A))
     with pytest.raises(SingularTangentError):
         factorize_envelope(sp.csr_matrix((3, 3)))
     with pytest.raises(SingularTangentError):  # singular: the fallback decides
