@@ -112,8 +112,9 @@ def _host_features() -> None:
     """
     from numba.core import codegen
 
-    codegen.AOTCPUCodegen._customize_tm_features = (
-        lambda self: self._get_host_cpu_features())
+    if hasattr(codegen.CPUCodegen, "_get_host_cpu_features"):  # numba 0.60 (pinned)
+        codegen.AOTCPUCodegen._customize_tm_features = (
+            lambda self: self._get_host_cpu_features())
 
 
 def build(out_dir: Path) -> dict:
