@@ -472,3 +472,39 @@ def test_structure_of_an_unsymmetric_pattern_is_its_symmetric_closure(numeric):
     outside = s.positions < 0
     assert not numeric or np.all(A.data[s.slots[outside]] == 0.0)
     assert numeric or not np.any(outside)
+
+
+def test_storage_arrays_are_reused_only_when_no_factorisation_holds_them():
+    """Factorisations of one structure share its spare storage arrays
+    (EnvelopeStructure.storage_array): a live one keeps solving its own matrix; a released
+    array is reused, from zero (the fill-in the last factors left where the next matrix has
+    no entry would corrupt it)."""
+    rng = np.random.default_rng(7)
+    n = 120
+    A1 = _variable_band(rng, n, rng.integers(0, 30, size=n))
+    A1.sort_indices()
+    s = EnvelopeStructure.of(A1)
+
+    def on_the_pattern():  # new values, A1's (symmetric) pattern, a dominant diagonal
+        A = A1.copy()
+        A.data = rng.normal(size=A.data.size)
+        A = (A + A.T + sp.diags(np.full(n, 40.0))).tocsr()
+        A.sort_indices()
+        assert s.matches(A)
+        return A
+
+    b = rng.normal(size=n)
+    fac1 = factorize_envelope(A1, s)
+    x1 = fac1.solve(b)
+    for _ in range(4):
+        A = on_the_pattern()
+        fac = factorize_envelope(A, s)
+        assert isinstance(fac, EnvelopeFactorization)
+        assert np.allclose(A @ fac.solve(b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
+    assert np.array_equal(fac1.solve(b), x1)  # held all along: never overwritten
+    before = {e.ctypes.data for e in s.__dict__["_spares"]}  # addresses: no extra reference
+    del fac  # its array comes free
+    A = on_the_pattern()
+    fac = factorize_envelope(A, s)
+    assert fac._env.ctypes.data in before  # reused, not new
+    assert np.allclose(A @ fac.solve(b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
