@@ -8,8 +8,11 @@ or of higher core levels do not widen the whole band), with none of a general sp
 symbolic overhead. Two storages (chosen per pattern by their operation counts,
 :data:`COLUMN_ADVANTAGE`): ``"columns"``, column j holding rows j … last[j] with last
 non-decreasing (a band is the special case), factorised right-looking by contiguous AXPYs
-(:func:`_column_ldlt`); ``"envelope"``, the row envelope exactly, factorised row by row by
-Crout's dot products (:func:`_ldlt`).
+(:func:`_column_ldlt`) or, wider than :data:`PANEL_MIN_WIDTH`, by panels of eight columns and
+rank-8 updates (:func:`_panel_ldlt`); ``"envelope"``, the row envelope exactly, factorised row
+by row by Crout's dot products (:func:`_ldlt`). The storage is loaded from the CSR values by
+runs of consecutive slots (:attr:`EnvelopeStructure.runs`) into an array reused while no
+factorisation holds it (:meth:`EnvelopeStructure.storage_array`).
 
 The factorisation is the one :class:`sandwich.solver.sparse.SparseFactorization` asks SuperLU
 for — symmetric, without pivoting, so ``K = L D Lᵀ`` and, by Sylvester's law of inertia, the
