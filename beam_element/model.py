@@ -336,6 +336,18 @@ class BeamModel:
             raise ValueError(f"expected a vector of {self.size} free DOFs, got shape {u.shape}")
         return self.dof_map.expand(u)
 
+    def internal_force_only(self, u: np.ndarray) -> np.ndarray:
+        """f_int(u) without the tangent, for a line search's trial.
+
+        :meth:`internal_force` bit for bit, at the cost of the force kernels alone (≈ 1/5 of
+        force + tangent). Leaves the evaluation cache as it was: a :meth:`tangent` at this u
+        evaluates in full.
+        """
+        if self._cache is not None and np.array_equal(self._cache[0], u):
+            return self._cache[1]
+        f_full, _ = self.full_response(self.expand(u), tangent=False)
+        return self.dof_map.reduce(f_full)
+
     def internal_force_nearby(self, u: np.ndarray) -> np.ndarray:
         """f_int(u) for an iterate within a converged increment of the last evaluated one.
 

@@ -263,9 +263,14 @@ def _backtrack(
     instead of creeping on).
     """
     alpha = 1.0
+    # the full step's force through internal_force: accepted, its tangent is the next one; the
+    # halved trials (mostly rejected) through the force alone where the system offers it
+    force = system.internal_force
+    force_only = getattr(system, "internal_force_only", None) or force
     for _ in range(halvings + 1):
         try:
-            f_int = np.asarray(system.internal_force(u + alpha * du), dtype=float)
+            f_int = np.asarray(force(u + alpha * du), dtype=float)
+            force = force_only
         except RECOVERABLE_ERRORS:
             f_int = None
         if f_int is not None and norm(f_int - (lam + alpha * dlam) * f_ref) < r_norm:

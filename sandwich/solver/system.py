@@ -23,6 +23,12 @@ A system may also provide ``internal_force_nearby(u)``: f_int(u), exactly as
 the parts the system knows such a step cannot change measurably and re-evaluate only the rest
 (the beam keeps its layers' tangent and re-evaluates the contact law, whose knee is what such
 iterations still resolve: :mod:`sandwich.solver.newton`).
+
+A system may also provide ``internal_force_only(u)``: f_int(u), exactly as
+``internal_force(u)`` (bit for bit), without the work a following ``tangent(u)`` could reuse
+(the beam assembles its tangent in the same pass as the force). The line search asks for its
+halved trials through it: most of them are rejected, and the one accepted is evaluated again,
+in full, when its tangent is asked for.
 """
 
 from __future__ import annotations

@@ -93,3 +93,16 @@ def test_a_path_with_and_without_the_nearby_evaluation(fig5):
         assert a.load_factor == pytest.approx(b.load_factor, rel=1e-7, abs=1e-9)
         for name, value in a.probes.items():
             assert value == pytest.approx(b.probes[name], rel=1e-7, abs=1e-9)
+
+
+@pytest.mark.parametrize("level", [1, 2])
+def test_force_only_is_the_full_force_bit_for_bit_and_leaves_the_cache(fig5, level):
+    """``internal_force_only`` (the line search's halved trials): the same force as a full
+    evaluation of a fresh model, contact pressed; the last full evaluation stays cached."""
+    model, u0, u1 = _states(fig5, level)
+    K0 = model.tangent(u0)
+    f_only = model.internal_force_only(u1)
+    fresh = build_model(fig5, elements=60, core_level=level)
+    assert np.array_equal(f_only, fresh.internal_force(u1))
+    assert model.tangent(u0) is K0  # the cache still holds u0's evaluation
+    assert np.array_equal(model.tangent(u1).toarray(), fresh.tangent(u1).toarray())

@@ -91,3 +91,35 @@ def test_a_residual_within_the_tolerance_is_not_line_searched():
                          NewtonSettings(tol=1e-8, max_iterations=10, backtracks=12))
     assert res.converged, res.reason
     assert res.u[0] == pytest.approx(1.0 / 3.0, abs=2e-9)
+
+
+class AtanSpringForceOnly(AtanSpring):
+    """The same system with ``internal_force_only`` (the same force, counted apart)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.only = 0
+        self.full_points: list[float] = []
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        self.full_points.append(float(u[1]))
+        return super().internal_force(u)
+
+    def internal_force_only(self, u: np.ndarray) -> np.ndarray:
+        self.only += 1
+        return np.array([u[0], math.atan(u[1])])
+
+
+def test_halved_trials_ask_for_the_force_only_with_the_same_iterates():
+    """The full step's trial through internal_force, the halved ones through
+    internal_force_only: the same iterates and answer as without it (closed form above)."""
+    plain, ref = _solve(backtracks=12)
+    system = AtanSpringForceOnly()
+    c = system.probe_vector("x")
+    res = newton_correct(system, np.array([0.0, 3.0]), 0.0,
+                         ProbeConstraint(c, 0.5, lambda a, b: float(a @ b)),
+                         NewtonSettings(tol=1e-12, max_iterations=40, backtracks=12))
+    assert res.converged and res.iterations == ref.iterations
+    np.testing.assert_array_equal(res.u, ref.u)
+    assert system.only > 0  # there were halvings (from y = 3 the full steps overshoot)
+    assert system.evaluations + system.only == plain.evaluations  # one force per trial
