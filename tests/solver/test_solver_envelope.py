@@ -55,7 +55,7 @@ def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeyp
 
 @pytest.mark.parametrize("seed", range(6))
 def test_panels_give_the_inertia_and_solves_of_dense_lapack(seed, monkeypatch):
-    """The panel kernel (column storage wider than PANEL_MIN_WIDTH): negative pivots against
+    """The panel kernel (columns longer than PANEL_MIN_WIDTH on average): negative pivots against
     eigvalsh, solves against the dense matrix, on random indefinite bands whose size is not a
     multiple of the panel (a last, narrower panel) and whose widths vary (zero-padded panel
     columns); and the same factors as the column kernel to round-off."""
