@@ -508,3 +508,22 @@ def test_storage_arrays_are_reused_only_when_no_factorisation_holds_them():
     fac = factorize_envelope(A, s)
     assert fac._env.ctypes.data in before  # reused, not new
     assert np.allclose(A @ fac.solve(b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
+
+
+def test_panel_flop_count_against_a_panel_by_panel_count():
+    """``_panel_flops`` (vectorised) against a count written panel by panel from the kernel's
+    loops: per column 1 reciprocal + m products + 2 per earlier panel column and row; per
+    trailing column of a panel reaching R, a rank-8 update of R − k + 1 rows (16 flops each,
+    the padding's zero terms included)."""
+    rng = np.random.default_rng(3)
+    for n in (1, 7, 8, 9, 100, 203):
+        last = envelope._column_last(np.maximum(np.arange(n) - rng.integers(0, 30, n), 0))
+        count = 0
+        for j in range(0, n, envelope.PANEL):
+            w = min(envelope.PANEL, n - j)
+            for p in range(w):
+                m = int(last[j + p]) - (j + p)
+                count += 1 + m + 2 * p * (m + 1)
+            R = int(last[j + w - 1])
+            count += sum(16 * (R - k + 1) for k in range(j + w, R + 1))
+        assert envelope._panel_flops(last) == count
