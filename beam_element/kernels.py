@@ -56,7 +56,8 @@ from sandwich.solver.jit import njit
 
 __all__ = ["KernelOperators", "block_pattern", "block_slots", "embed_pattern", "kernel_operators",
            "layer_assemble", "layer_blocks", "layer_flops", "layer_response", "point_flops",
-           "scatter_blocks", "scatter_compact", "supports", "uses_sum_factorisation"]
+           "scatter_blocks", "scatter_compact", "scatter_compact_known", "supports",
+           "uses_sum_factorisation"]
 
 
 @dataclass(frozen=True)
@@ -343,6 +344,54 @@ def scatter_compact(free, sign, K, indptr, indices, data):  # pragma: no cover -
                 if lo < hi0 and indices[lo] == c:
                     data[lo] += sign[b, i] * sign[b, j] * K[b, i, j]
                 else:
+                    misses += 1
+    return misses
+
+
+@njit
+def scatter_compact_known(free, sign, K, indptr, indices, data, known_free,
+                          known_slots):  # pragma: no cover - compiled
+    """:func:`scatter_compact` with each block's slots remembered between calls.
+
+    ``known_free`` (B, m) and ``known_slots`` (B, m, m) hold the reduced DOFs and the CSR slots
+    (−1 eliminated, −2 not in the pattern) of each block at its last call on this pattern: a
+    block whose DOFs are unchanged (a contact pair on the same segment: most pairs, most
+    iterations) is added without searching its rows; the others are searched and remembered.
+    The same sums as :func:`scatter_compact`, in the same order. Returns the misses.
+    """
+    misses = 0
+    B, m = free.shape
+    for b in range(B):
+        same = True
+        for i in range(m):
+            if known_free[b, i] != free[b, i]:
+                same = False
+                break
+        if not same:
+            for i in range(m):
+                r = free[b, i]
+                for j in range(m):
+                    c = free[b, j]
+                    slot = -1
+                    if r >= 0 and c >= 0:
+                        lo, hi = indptr[r], indptr[r + 1]
+                        end = hi
+                        while lo < hi:
+                            mid = (lo + hi) // 2
+                            if indices[mid] < c:
+                                lo = mid + 1
+                            else:
+                                hi = mid
+                        slot = lo if lo < end and indices[lo] == c else -2
+                    known_slots[b, i, j] = slot
+            for i in range(m):
+                known_free[b, i] = free[b, i]
+        for i in range(m):
+            for j in range(m):
+                slot = known_slots[b, i, j]
+                if slot >= 0:
+                    data[slot] += sign[b, i] * sign[b, j] * K[b, i, j]
+                elif slot == -2:
                     misses += 1
     return misses
 

@@ -449,7 +449,7 @@ class BeamModel:
             data = nearby.K.data  # taken over: the last contact terms out, the new ones in
             for kind, a, b, c in nearby.terms[1]:
                 if kind == "compact":
-                    kernels.scatter_compact(a, b, -c, pattern.indptr, pattern.indices, data)
+                    self._scatter_compact(kernels, a, *b, -c, pattern, data)
                 else:
                     kernels.scatter_blocks(-c, *pattern.slots_of(a), data)
             nearby.terms = None
@@ -487,11 +487,10 @@ class BeamModel:
                 free = np.ascontiguousarray(self.dof_map.free[dofs10], dtype=np.int64)
                 sign = np.where(free >= 0, self.dof_map.sign[dofs10], 0).astype(np.int8)
                 K10 = np.ascontiguousarray(K10)
-                if kernels.scatter_compact(free, sign, K10,
-                                           pattern.indptr, pattern.indices, data):
+                if self._scatter_compact(kernels, j, free, sign, K10, pattern, data):
                     self._grow_pattern(_segments_around(pairs, cols))
                     return self._compiled_forces(u_full, kernels)
-                terms.append(("compact", free, sign, K10))
+                terms.append(("compact", j, (free, sign), K10))
                 continue
             f, K, p, k = penalty_response(pairs, u_full, self.penalty, self.smoothing)
             forces.append(f)
@@ -503,6 +502,24 @@ class BeamModel:
         K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
         assembled = _Assembled(K, contact, (pattern, terms))
         return scatter_vector(u_full.size, force_dofs, forces), assembled
+
+    def _scatter_compact(self, kernels: object, group: int, free: np.ndarray, sign: np.ndarray,
+                         K: np.ndarray, pattern: ReducedPattern, data: np.ndarray) -> int:
+        """Closest-point group ``group``'s blocks into ``data``, its slots remembered.
+
+        :func:`beam_element.kernels.scatter_compact_known` with this group's remembered DOFs
+        and slots on ``pattern`` (dropped when the pattern grows). Returns the misses.
+        """
+        known = self.__dict__.get("_compact_slots")
+        if known is None or known[0] is not pattern:
+            known = self.__dict__["_compact_slots"] = (pattern, {})
+        if group not in known[1] or known[1][group][0].shape != free.shape:
+            B, m = free.shape
+            known[1][group] = (np.full((B, m), -9, dtype=np.int64),
+                               np.empty((B, m, m), dtype=np.int64))
+        known_free, known_slots = known[1][group]
+        return kernels.scatter_compact_known(free, sign, K, pattern.indptr, pattern.indices,
+                                             data, known_free, known_slots)
 
     def _zeroed_values(self, size: int) -> np.ndarray:
         """A zeroed array for a tangent's CSR values: a spare one no one else holds, or new.

@@ -401,3 +401,35 @@ def test_reduced_pattern_is_the_same_with_and_without_the_compiled_builder(optio
     slot_row = np.repeat(np.arange(fast.n), np.diff(fast.indptr))
     assert np.array_equal(slot_row[fast.slot], r[ok]) and np.array_equal(
         fast.indices[fast.slot], c[ok])
+
+
+def test_remembered_compact_slots_add_the_same_sums_as_the_search():
+    """kernels.scatter_compact_known against kernels.scatter_compact (the binary search in each
+    row, which it replaces for blocks whose DOFs are unchanged): the same values bit for bit
+    and the same misses, over calls where some blocks keep their DOFs, some move to other
+    DOFs, some have eliminated DOFs (−1) and some hit entries outside the pattern."""
+    rng = np.random.default_rng(11)
+    n, B, m = 40, 12, 4
+    dense = (rng.random((n, n)) < 0.3) | np.eye(n, dtype=bool)
+    dense[:, 35:] = dense[35:, :] = False  # DOFs 35-39 couple to nothing: misses
+    np.fill_diagonal(dense, True)
+    P = sp.csr_matrix(dense.astype(float))
+    P.sort_indices()
+    indptr, indices = P.indptr.astype(np.int64), P.indices.astype(np.int64)
+    known_free = np.full((B, m), -9, dtype=np.int64)
+    known_slots = np.empty((B, m, m), dtype=np.int64)
+    free = rng.integers(-1, n, size=(B, m)).astype(np.int64)
+    sign = rng.choice(np.array([-1, 1], dtype=np.int8), size=(B, m))
+    for call in range(5):
+        if call:  # a few blocks move, the others keep their DOFs (and their remembered slots)
+            moved = rng.random(B) < 0.3
+            free[moved] = rng.integers(-1, n, size=(int(moved.sum()), m))
+            free[call, m - 1] = (free[call, m - 1] + 7) % n  # one block: its last DOF only
+        K = rng.standard_normal((B, m, m))
+        d0, d1 = np.zeros(indices.size), np.zeros(indices.size)
+        misses0 = kernels.scatter_compact(free, sign, K, indptr, indices, d0)
+        misses1 = kernels.scatter_compact_known(free, sign, K, indptr, indices, d1, known_free,
+                                                known_slots)
+        assert misses1 == misses0
+        assert np.array_equal(d1, d0)
+    assert misses0 > 0 and np.any(free < 0)  # both cases were met
