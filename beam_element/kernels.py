@@ -329,23 +329,30 @@ def scatter_compact(free, sign, K, indptr, indices, data):  # pragma: no cover -
             r = free[b, i]
             if r < 0:
                 continue
-            lo0, hi0 = indptr[r], indptr[r + 1]
             for j in range(m):
                 c = free[b, j]
                 if c < 0:
                     continue
-                lo, hi = lo0, hi0
-                while lo < hi:
-                    mid = (lo + hi) // 2
-                    if indices[mid] < c:
-                        lo = mid + 1
-                    else:
-                        hi = mid
-                if lo < hi0 and indices[lo] == c:
-                    data[lo] += sign[b, i] * sign[b, j] * K[b, i, j]
+                slot = _csr_slot(indptr, indices, r, c)
+                if slot >= 0:
+                    data[slot] += sign[b, i] * sign[b, j] * K[b, i, j]
                 else:
                     misses += 1
     return misses
+
+
+@njit
+def _csr_slot(indptr, indices, r, c):  # pragma: no cover - compiled
+    """The slot of entry (r, c) in a CSR pattern with sorted rows (binary search), or −1."""
+    lo, hi = indptr[r], indptr[r + 1]
+    end = hi
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if indices[mid] < c:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo if lo < end and indices[lo] == c else -1
 
 
 @njit
@@ -374,15 +381,8 @@ def scatter_compact_known(free, sign, K, indptr, indices, data, known_free,
                     c = free[b, j]
                     slot = -1
                     if r >= 0 and c >= 0:
-                        lo, hi = indptr[r], indptr[r + 1]
-                        end = hi
-                        while lo < hi:
-                            mid = (lo + hi) // 2
-                            if indices[mid] < c:
-                                lo = mid + 1
-                            else:
-                                hi = mid
-                        slot = lo if lo < end and indices[lo] == c else -2
+                        slot = _csr_slot(indptr, indices, r, c)
+                        slot = slot if slot >= 0 else -2
                     known_slots[b, i, j] = slot
             for i in range(m):
                 known_free[b, i] = free[b, i]
