@@ -9,7 +9,6 @@ force and tangent on the free DOFs.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,6 +53,7 @@ from beam_element.loads import (
 from beam_element.mesh import DEFAULT_GROWTH, DEFAULT_SIZE_RATIO, BeamMesh, build_mesh
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.scene import FACE_MEMBRANES, GRADINGS, BeamModelOptions
+from sandwich.solver.spares import free_array
 
 CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
 PENALTY_FACTOR = 1e4  # default contact penalty ε = PENALTY_FACTOR · Q_z / h_c  (N/mm³)
@@ -522,26 +522,14 @@ class BeamModel:
                                              data, known_free, known_slots)
 
     def _zeroed_values(self, size: int) -> np.ndarray:
-        """A zeroed array for a tangent's CSR values: a spare one no one else holds, or new.
+        """A zeroed array for a tangent's CSR values: a spare no one else holds, or a new one.
 
-        Freshly allocated, a large array costs one page fault per 4 KiB page on first read and
-        another on first write (960 elements at level 3: 46 MB of values, 22 000 faults,
-        ≈ 30 ms of a 74 ms evaluation); zeroing a spare in place costs a pass over memory. A
-        spare is reused only when its reference count says that nothing outside this list
-        holds it — no matrix, no view (a view holds its base) — so no live tangent is ever
-        overwritten; the model's cached tangent keeps the last one, hence two spares at most.
+        :func:`sandwich.solver.spares.free_array` (fresh large arrays cost page faults); the
+        model's cached tangent keeps the last one.
         """
-        spares = self.__dict__.setdefault("_spare_values", [])
-        for i in range(len(spares)):
-            buffer = spares[i]
-            # referenced by the list, this name and getrefcount's argument only: free
-            if buffer.size == size and sys.getrefcount(buffer) <= 3:
-                buffer.fill(0.0)
-                return buffer
-        buffer = np.zeros(size)
-        spares.insert(0, buffer)
-        del spares[SPARE_VALUES:]
-        return buffer
+        values = free_array(self.__dict__.setdefault("_spare_values", []), size, SPARE_VALUES)
+        values.fill(0.0)
+        return values
 
     def _tangent_blocks(
         self, u_full: np.ndarray, states: list[list[LayerState]]

@@ -58,7 +58,6 @@ the ordering.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -66,6 +65,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from sandwich.solver.jit import njit
+from sandwich.solver.spares import free_array
 from sandwich.solver.sparse import GROWTH_LIMIT, SingularTangentError, SparseFactorization
 
 __all__ = ["EnvelopeFactorization", "EnvelopeStructure", "factorize_envelope"]
@@ -202,21 +202,12 @@ class EnvelopeStructure:
     def storage_array(self) -> np.ndarray:
         """An array of :attr:`size` for a factorisation's storage (its content arbitrary).
 
-        A spare one that nothing else holds (its reference count: no factorisation, no view)
-        or a new one: a fresh large array costs a page fault per 4 KiB on first touch (960
-        elements at core level 3: 28 MB, 6900 faults per factorisation). Up to
-        :data:`SPARE_STORAGE` are kept per structure (the path follower keeps the last
-        converged state's factorisation while the corrector makes new ones).
+        :func:`sandwich.solver.spares.free_array` over this structure's spares (960 elements
+        at core level 3: 28 MB, 6900 page faults per factorisation when new); up to
+        :data:`SPARE_STORAGE` are kept (the path follower keeps the last converged state's
+        factorisation while the corrector makes new ones).
         """
-        spares = self.__dict__.setdefault("_spares", [])
-        for i in range(len(spares)):
-            env = spares[i]
-            if sys.getrefcount(env) <= 3:  # the list, this name, getrefcount's argument
-                return env
-        env = np.empty(self.size)
-        spares.insert(0, env)
-        del spares[SPARE_STORAGE:]
-        return env
+        return free_array(self.__dict__.setdefault("_spares", []), self.size, SPARE_STORAGE)
 
     @cached_property
     def panels(self) -> bool:
