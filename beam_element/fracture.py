@@ -173,10 +173,11 @@ def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip],
     if not tips:
         return []
     u_full = model.expand(u)
-    f_full = model.full_response(u_full, tangent=False)[0]
-    return [_closure(model, u_full, f_full, t,
-                     closure_elements(model, t) if elements is None else elements)
-            for t in tips]
+    counts = [closure_elements(model, t) if elements is None else elements for t in tips]
+    near = np.unique(np.concatenate([_closure_support(model, t, n)
+                                     for t, n in zip(tips, counts, strict=True)]))
+    f_full = model.full_response(u_full, tangent=False, elements=near)[0]
+    return [_closure(model, u_full, f_full, t, n) for t, n in zip(tips, counts, strict=True)]
 
 
 def release_columns(model: BeamModel, u: np.ndarray, tips: list[BeamTip]
@@ -230,16 +231,49 @@ def _tied(model: BeamModel, interface: str, node: int) -> bool:
     return bool(np.all(free[core] == free[face]))
 
 
+def _behind_nodes(model: BeamModel, t: BeamTip, elements: int) -> list[int]:
+    """The tip node and up to ``elements`` untied nodes behind it (into the debond)."""
+    back = int(np.sign(t.behind - t.node))
+    nodes = [t.node]
+    k = t.node + back
+    while len(nodes) <= elements and 0 <= k < len(model.mesh.x) \
+            and not _tied(model, t.interface, k):
+        nodes.append(k)
+        k += back
+    return nodes
+
+
+def _ahead_nodes(model: BeamModel, t: BeamTip, delta: float) -> list[int]:
+    """The tip node and the bonded nodes ahead of it closer than ``delta``: the R_k read."""
+    x = model.mesh.x
+    back = int(np.sign(t.behind - t.node))
+    nodes = []
+    k = t.node
+    while 0 <= k < len(x) and abs(x[k] - x[t.node]) < delta * (1.0 - 1e-9):
+        nodes.append(k)
+        k -= back
+    return nodes
+
+
+def _closure_support(model: BeamModel, t: BeamTip, elements: int) -> np.ndarray:
+    """The elements whose layers' forces reach the tie reactions :func:`_closure` reads.
+
+    Node k's DOFs belong to elements k − 1 and k only: the force there from these elements
+    (and every contact pair) is the whole internal force (tested against the full one).
+    """
+    behind = _behind_nodes(model, t, elements)
+    if len(behind) < 2:
+        return np.zeros(0, dtype=int)
+    x = model.mesh.x
+    nodes = np.asarray(_ahead_nodes(model, t, float(abs(x[behind[-1]] - x[t.node]))))
+    els = np.concatenate([nodes - 1, nodes])
+    return els[(els >= 0) & (els < model.mesh.n_elements)]
+
+
 def _closure(model: BeamModel, u_full: np.ndarray, f_full: np.ndarray, t: BeamTip,
              elements: int) -> TipRelease:
     x = model.mesh.x
-    back = int(np.sign(t.behind - t.node))
-    n_nodes = len(x)
-    behind_nodes = [t.node]
-    k = t.node + back
-    while len(behind_nodes) <= elements and 0 <= k < n_nodes and not _tied(model, t.interface, k):
-        behind_nodes.append(k)
-        k += back
+    behind_nodes = _behind_nodes(model, t, elements)
     if len(behind_nodes) < 2:
         return TipRelease(t.debond, t.tip, 0.0, 0.0, 0.0, 0.0)
     delta = float(abs(x[behind_nodes[-1]] - x[t.node]))
@@ -249,18 +283,14 @@ def _closure(model: BeamModel, u_full: np.ndarray, f_full: np.ndarray, t: BeamTi
     jumps[0] = 0.0  # the tip node is tied
     c, s = _frame(model, u_full, t)
     work_n = work_t = 0.0
-    k = t.node
-    while 0 <= k < n_nodes:
+    for k in _ahead_nodes(model, t, delta):
         s_k = abs(x[k] - x[t.node])
-        if s_k >= delta * (1.0 - 1e-9):
-            break
         R = f_full[tie_dofs(t.interface, k)[0]]  # face on core: N, N, N·mm
         d = np.array([np.interp(delta - s_k, r_b, jumps[:, j]) for j in range(3)])
         R_t, R_n = c * R[0] + s * R[1], -s * R[0] + c * R[1]
         d_t, d_n = c * d[0] + s * d[1], -s * d[0] + c * d[1]
         work_n += R_n * d_n + R[2] * d[2]
         work_t += R_t * d_t
-        k -= back
     scale = 1.0 / (2.0 * model.width * delta)
     gi = max(scale * work_n, 0.0)
     gii = scale * work_t

@@ -542,22 +542,36 @@ class BeamModel:
         return blocks
 
     def full_response(
-        self, u_full: np.ndarray, tangent: bool = True, contact_blocks: bool = True
+        self, u_full: np.ndarray, tangent: bool = True, contact_blocks: bool = True,
+        elements: np.ndarray | None = None,
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Internal force on the full DOFs and the local tangent blocks (layers, then contact).
 
         Layers by the compiled kernels (block output) when :attr:`use_kernels` and numba allow,
         else by the NumPy reference path (:mod:`beam_element.element`). Without ``tangent``
         (or with ``contact_blocks`` False: the layer blocks only) no closest-point pair's
-        (m, n, n) block is formed.
+        (m, n, n) block is formed. ``elements`` (force only): the layers of these elements
+        alone, every contact pair — the force is exact at the DOFs no other element reaches
+        (a debond tip's closure, :func:`beam_element.fracture.tip_releases`).
         """
         kernels = _kernels() if self.use_kernels else None
+        if elements is not None:
+            if tangent:
+                raise ValueError("full_response: elements restricts the force only")
+            if kernels is None:  # the NumPy path evaluates every element
+                return self.full_response(u_full, tangent=False)
         if kernels is None:
             f_full, states = self._forces(u_full, compiled=False)
             return f_full, (self._tangent_blocks(u_full, states) if tangent else [])
-        forces, blocks = [], []
+        forces, blocks, rows = [], [], []
         lengths = self.mesh.lengths
         for op, products, els, dofs in self._families():
+            if elements is not None:
+                keep = np.isin(els, elements)
+                if not keep.any():
+                    continue
+                els, dofs = els[keep], dofs[keep]
+            rows.append(dofs)
             if kernels.supports(op):
                 f, K = kernels.layer_blocks(op, u_full[dofs], lengths[els], self.width, tangent)
             else:
@@ -579,7 +593,8 @@ class BeamModel:
             forces.append(f)
             if contact_blocks:
                 blocks.append(K)
-        return scatter_vector(u_full.size, self.block_dofs, forces), (blocks if tangent else [])
+        rows += [pairs.block_dofs for pairs in self.pairs]
+        return scatter_vector(u_full.size, rows, forces), (blocks if tangent else [])
 
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
         """Penetration, pressure and sliding per interface at free DOFs ``u``."""
