@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,9 +29,9 @@ from beam_element.core_levels import (
 from beam_element.fields import profile_columns, section_fields
 from beam_element.fracture import (
     beam_tips,
-    history_columns,
+    column_names,
     level_warning,
-    tip_releases,
+    release_columns,
     uniform_tip_levels,
 )
 from beam_element.model import BeamModel, beam_mesh, build_model
@@ -86,6 +86,7 @@ class ConvergedState:
     u: np.ndarray
     iterations: int
     probes: dict[str, float]
+    extra: dict[str, float | None] = field(default_factory=dict)  # the path's state columns
 
 
 @dataclass
@@ -653,8 +654,8 @@ def _follow(
     options = PathOptions.from_analysis(a, min_increment=_min_increment(model, a),
                                         desired_iterations=DESIRED_ITERATIONS, **caps)
     result = follow_path(model, options, list(model.probe_rows), progress)
-    states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes))
-              for s in result.states]
+    states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes),
+                             dict(s.extra)) for s in result.states]
     return states, result.message, result.reached_target, list(result.limit_points)
 
 
@@ -693,6 +694,7 @@ def _solution(
     history = []
     max_pen = max_slide = 0.0
     tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
+    names = {n for t in tips for n in column_names(t.debond, t.tip)}
     for s in states:
         summary = model.contact_summary(s.u) if nonlinear else {}
         pen = max((c.max_penetration for c in summary.values()), default=0.0)
@@ -700,7 +702,9 @@ def _solution(
         max_pen, max_slide = max(max_pen, pen), max(max_slide, slide)
         extra = {"max_penetration": pen, "max_sliding": slide,
                  "contact_pairs_active": float(sum(c.active for c in summary.values())),
-                 **history_columns(tip_releases(model, s.u, tips))}
+                 # the path's columns of this state (model.state_columns), else evaluated
+                 **({n: s.extra[n] for n in names} if names <= s.extra.keys()
+                    else release_columns(model, s.u, tips))}
         history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
                                   iterations=s.iterations, extra=extra))
     every = int(getattr(getattr(scene, "beam_model", None), "profile_every", 0) or 0)

@@ -65,3 +65,24 @@ def test_the_restricted_force_is_the_full_one_at_the_tip_nodes_only():
     assert not np.allclose(f_some[edge], f_full[edge], rtol=1e-6)
     with pytest.raises(ValueError, match="force only"):
         model.full_response(u_full, tangent=True, elements=some)
+
+
+def test_the_history_takes_the_paths_columns_without_evaluating_them_again(monkeypatch):
+    import beam_element.fracture as fracture
+
+    calls = []
+    real = fracture.tip_releases
+
+    def counting(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fracture, "tip_releases", counting)
+    sc, r = _state(1)
+    assert len(calls) == len(r.states)  # once per accepted state (the follower's columns)
+    monkeypatch.undo()
+    tips = beam_tips(sc, r.model)
+    for s, record in zip(r.states, r.solution.history, strict=True):
+        for g in tip_releases(r.model, s.u, tips):
+            name = f"G_{g.debond}_{g.tip}"
+            assert record.extra[name] == pytest.approx(g.G, rel=1e-12, abs=1e-300)
