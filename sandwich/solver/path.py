@@ -639,19 +639,30 @@ class _Follower:
     ) -> tuple[_Trial, float, str]:
         """If ``trial`` overshoots a stopping target, shorten the step to hit it.
 
-        First one corrector from the chord's point on the target (:meth:`_chord_target`). If
-        it fails or is refused, the step size ``x ∈ (0, h)`` is found by regula falsi with the
-        Illinois modification on ``g(x) = value(step of size x) − target``, each evaluation a
-        full corrector run from ``last``. Returns the step to accept, its size and the crossed
-        target's name ("" if none was crossed).
+        A regular step (the tangent's inertia the same at ``last`` and ``trial``): first one
+        corrector from the chord's point on the target (:meth:`_chord_target`). A step across a
+        critical point (the inertia changed): first the target under its own control from
+        ``last``, in sub-increments (:meth:`_attempt_target`) — the arc passed a load maximum
+        or a bifurcation on the way and may have landed on another equilibrium (fig. 7 c1 at
+        the paper's core: its long last arc ends beyond the target on an equilibrium the path
+        followed in short steps does not reach), and shortened arcs from ``last`` then search
+        along it (c1: five correctors, three failing at 25 iterations, before this same
+        control found λ 758.4, the short-step path's value; c2: regula falsi's λ 736.843 to
+        5e-9). If these fail or are refused, the step size ``x ∈ (0, h)`` is found by regula
+        falsi with the Illinois modification on ``g(x) = value(step of size x) − target``,
+        each evaluation a full corrector run from ``last``. Returns the step to accept, its
+        size and the crossed target's name ("" if none was crossed).
         """
         crossed = self._crossings(last, trial)
         if not crossed:
             return trial, h, ""
         frac, name, target = crossed[0]
-        chord = self._chord_target(name, target, frac, last, trial)
-        if chord is not None:
-            return chord, self.wnorm(chord.u - last.u, chord.load_factor - last.load_factor), name
+        neg = last.negative_pivots
+        across = neg is not None and trial.factorization.negative_pivots not in (neg, None)
+        first = (self._attempt_target(name, target, last, t) if across
+                 else self._chord_target(name, target, frac, last, trial))
+        if first is not None:
+            return first, self.wnorm(first.u - last.u, first.load_factor - last.load_factor), name
         scale = max(abs(target), *(abs(self._value(name, s.u, s.load_factor))
                                    for s in self.states))
         tol = self.opt.target_tol * scale
@@ -686,7 +697,7 @@ class _Follower:
                 if side == 1:
                     fb *= 0.5
                 side = 1
-        if abs(best_g) > tol:
+        if abs(best_g) > tol and not across:
             # The arc through the bracket can lose its real roots on short arcs (Crisfield's
             # quadratic); the target itself is then a better control equation: one corrector
             # from ``last`` with "value(name) = target" (load or displacement control).
@@ -739,12 +750,13 @@ class _Follower:
         whose long last arc (24 iterations) passes the load maximum (0 → 1 negative pivots) and
         lands on another equilibrium beyond the target; from its chord the corrector converges
         at λ 691.6, on that other equilibrium, while the path followed in short steps reaches
-        the target at λ 758.4, as the regula-falsi route's sub-incremented target control
-        does. fig. 4's auto pass at levels {1: 150, 2: 90} steps from λ 1436.5 (w −7.7 mm, a
-        load maximum) to λ 1246 beyond −15 mm with the inertia unchanged; its chord's corrector
-        converges at λ 1198.0, outside that bracket, where regula falsi (as before) ends at
-        λ 1880.7, the end state auto's check found: two equilibria at the target, one step
-        apart, and no reason to prefer the chord's.
+        the target at λ 758.4, as the sub-incremented target control does (which
+        :meth:`_hit_crossed_target` tries first on such a step). fig. 4's auto pass at levels
+        {1: 150, 2: 90} steps from λ 1436.5 (w −7.7 mm, a load maximum) to λ 1246 beyond
+        −15 mm with the inertia unchanged; its chord's corrector converges at λ 1198.0, outside
+        that bracket, where regula falsi (as before) ends at λ 1880.7, the end state auto's
+        check found: two equilibria at the target, one step apart, and no reason to prefer the
+        chord's.
         """
         neg = last.negative_pivots
         if neg is None or trial.factorization.negative_pivots != neg:

@@ -173,3 +173,50 @@ class _NoInertia:
 
     def __init__(self, fac):
         self.solve = fac.solve
+
+
+def _across(target_fraction=0.5):
+    """A follower whose step from before the truss's maximum to past it crosses until = w2."""
+    truss, f0, last, trial, fac0, fac1 = _step(past=True)
+    assert (fac0.negative_pivots, fac1.negative_pivots) == (0, 1)
+    target = last.u[1] + target_fraction * (trial.u[1] - last.u[1])
+    opts = PathOptions(control="arc-length", until_probe="w2", until_value=target, tol=TOL)
+    f = _Follower(truss, opts, ["w1", "w2"], None)
+    f.psi, f.prev_step, f.sigma = 1.0, None, 1.0
+    last = PathState(0, last.u, last.load_factor, 0, f.probes(last.u), 0)
+    f.states = [last]
+    t = np.linalg.solve(truss.tangent(last.u), truss.f_ref)
+    return truss, f, last, trial, t, target
+
+
+def test_a_step_across_the_maximum_hits_the_target_under_its_own_control(monkeypatch):
+    truss, f, last, trial, t, target = _across()
+    arcs = []
+    real = _Follower._attempt
+    monkeypatch.setattr(_Follower, "_attempt", lambda self, *a, **k: arcs.append(1) or
+                        real(self, *a, **k))
+    monkeypatch.setattr(_Follower, "_chord_target", lambda *a, **k: pytest.fail("chord"))
+    hit, _, name = f._hit_crossed_target(trial, 1.0, last, t)
+    assert name == "w2" and not arcs  # neither the chord nor regula falsi's arcs
+    # closed form: w2 = w1 + λ P / k is monotone in w1 here (k > max |f'|), λ P = f_bar(w1)
+    from scipy.optimize import brentq
+
+    w1 = brentq(lambda w: w + truss.bar_force(w) / truss.ks - target, last.u[0], trial.u[0],
+                xtol=1e-15)
+    assert math.isclose(hit.u[1], target, rel_tol=1e-12)
+    assert math.isclose(hit.u[0], w1, rel_tol=1e-8)
+    assert math.isclose(hit.load_factor, float(truss.bar_force(w1)) / truss.p_ref, rel_tol=1e-8)
+
+
+def test_across_the_maximum_a_failed_target_control_falls_back_to_regula_falsi(monkeypatch):
+    truss, f, last, trial, t, target = _across()
+    tries, arcs = [], []
+    monkeypatch.setattr(_Follower, "_attempt_target", lambda *a, **k: tries.append(1))
+    real = _Follower._attempt
+    monkeypatch.setattr(_Follower, "_attempt", lambda self, *a, **k: arcs.append(1) or
+                        real(self, *a, **k))
+    h = f.wnorm(trial.u - last.u, trial.load_factor - last.load_factor)
+    _, _, name = f._hit_crossed_target(trial, h, last, t)
+    assert name == "w2"
+    assert tries == [1]  # tried once, first, not again after regula falsi
+    assert arcs  # regula falsi's shortened arcs
