@@ -94,9 +94,14 @@ def profile_columns(
     η = _stations(per_element)
     ends = np.array([1.0])
 
+    samples: dict[tuple[str, float], tuple[LayerSample, LayerSample]] = {}
+
     def col(layer: str, ξ: float, what: str) -> np.ndarray:
-        s = sample_layer(model, layer, u_full, η, np.full_like(η, ξ), nonlinear)
-        e = sample_layer(model, layer, u_full, ends, np.array([ξ]), nonlinear)
+        if (layer, ξ) not in samples:  # each layer and height sampled once for its columns
+            samples[layer, ξ] = (
+                sample_layer(model, layer, u_full, η, np.full_like(η, ξ), nonlinear),
+                sample_layer(model, layer, u_full, ends, np.array([ξ]), nonlinear))
+        s, e = samples[layer, ξ]
         return _along(getattr(s, what), getattr(e, what))
 
     x = col("core", 0.0, "x")
