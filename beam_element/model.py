@@ -73,6 +73,23 @@ class ContactSummary:
     outside_reach: int = 0  # pairs in contact projecting beyond the searched segments
 
 
+#: The history's contact columns (:func:`contact_columns`).
+CONTACT_COLUMNS = ("max_penetration", "max_sliding", "contact_pairs_active")
+
+
+def contact_columns(summary: dict[str, ContactSummary]) -> dict[str, float]:
+    """History columns of a state's contact summary (0 without contact).
+
+    Deepest penetration (mm), largest sliding of a pair in contact (mm) and the pairs in
+    contact, over the interfaces.
+    """
+    return {
+        "max_penetration": max((c.max_penetration for c in summary.values()), default=0.0),
+        "max_sliding": max((c.max_sliding for c in summary.values()), default=0.0),
+        "contact_pairs_active": float(sum(c.active for c in summary.values())),
+    }
+
+
 @dataclass(frozen=True)
 class CoreGroup:
     """The core elements of one level: their rows, products and (extended) DOF indices."""
@@ -314,16 +331,22 @@ class BeamModel:
         return self.dof_map.reduce(self.probe_rows[name])
 
     def state_columns(self, u: np.ndarray) -> dict[str, float | None]:
-        """History columns of a converged state: G, G_I, G_II at every debond tip (N/mm).
+        """History columns of a converged state: contact and G at the debond tips.
 
-        Called by the path follower on every accepted state, so that a run interrupted
-        mid-path still writes them (:mod:`beam_element.fracture`).
+        Contact: :func:`contact_columns`; G, G_I, G_II at every debond tip (N/mm). Called by the
+        path follower on every accepted state (after :meth:`commit`, whose contact summary at
+        the same ``u`` it takes), so that a run interrupted mid-path still writes them
+        (:mod:`beam_element.fracture`) and the solution's history does not evaluate them again.
         """
-        return release_columns(self, u, self.fracture_tips)
+        at = self.__dict__.get("_committed_u")
+        summary = (self.committed if at is not None and np.array_equal(at, u)
+                   else self.contact_summary(u))
+        return {**contact_columns(summary), **release_columns(self, u, self.fracture_tips)}
 
     def commit(self, u: np.ndarray, load_factor: float) -> None:
         """Record the contact state of a converged step."""
         self.committed = self.contact_summary(u)
+        self.__dict__["_committed_u"] = np.array(u, dtype=float, copy=True)
         for s in self.committed.values():
             self.max_penetration_seen = max(self.max_penetration_seen, s.max_penetration)
             self.max_sliding_seen = max(self.max_sliding_seen, s.max_sliding)

@@ -34,7 +34,13 @@ from beam_element.fracture import (
     release_columns,
     uniform_tip_levels,
 )
-from beam_element.model import BeamModel, beam_mesh, build_model
+from beam_element.model import (
+    CONTACT_COLUMNS,
+    BeamModel,
+    beam_mesh,
+    build_model,
+    contact_columns,
+)
 from beam_element.quadrature import EXACT_ORDER
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
 from sandwich.scene import Scene
@@ -633,7 +639,7 @@ def _follow_penalised(
     model = build_model(scene, elements=elements, gauss=_gauss_orders(scene), **options)
     while True:
         states, message, converged, limit_points = _follow(model, scene, progress, max_steps)
-        pen, bound = _max_penetration(model, [s.u for s in states]), model.penetration_bound()
+        pen, bound = _states_penetration(model, states), model.penetration_bound()
         if pen <= bound or len(raised) == PENALTY_RESTARTS:
             return model, states, message, converged, limit_points, raised
         raised.append(model.penalty)
@@ -663,6 +669,17 @@ def _max_penetration(model: BeamModel, displacements: list[np.ndarray]) -> float
     """Deepest contact penetration (mm) over states given by their free DOFs."""
     return max((c.max_penetration for u in displacements
                 for c in model.contact_summary(u).values()), default=0.0)
+
+
+def _contact_columns(model: BeamModel, u: np.ndarray, nonlinear: bool) -> dict[str, float]:
+    """A state's contact history columns, evaluated (a linear analysis: none, zeros)."""
+    return contact_columns(model.contact_summary(u) if nonlinear else {})
+
+
+def _states_penetration(model: BeamModel, states: list[ConvergedState]) -> float:
+    """Deepest contact penetration (mm) over ``states``, from their path columns if kept."""
+    return max((s.extra["max_penetration"] if "max_penetration" in s.extra
+                else _max_penetration(model, [s.u]) for s in states), default=0.0)
 
 
 def solve(scene: Scene, progress: Callable[[object], None] | None = None) -> Solution:
@@ -696,13 +713,12 @@ def _solution(
     tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
     names = {n for t in tips for n in column_names(t.debond, t.tip)}
     for s in states:
-        summary = model.contact_summary(s.u) if nonlinear else {}
-        pen = max((c.max_penetration for c in summary.values()), default=0.0)
-        slide = max((c.max_sliding for c in summary.values()), default=0.0)
-        max_pen, max_slide = max(max_pen, pen), max(max_slide, slide)
-        extra = {"max_penetration": pen, "max_sliding": slide,
-                 "contact_pairs_active": float(sum(c.active for c in summary.values())),
-                 # the path's columns of this state (model.state_columns), else evaluated
+        # the path's columns of this state (model.state_columns), else evaluated
+        contact = ({n: s.extra[n] for n in CONTACT_COLUMNS} if set(CONTACT_COLUMNS) <=
+                   s.extra.keys() else _contact_columns(model, s.u, nonlinear))
+        max_pen = max(max_pen, contact["max_penetration"])
+        max_slide = max(max_slide, contact["max_sliding"])
+        extra = {**contact,
                  **({n: s.extra[n] for n in names} if names <= s.extra.keys()
                     else release_columns(model, s.u, tips))}
         history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
