@@ -196,8 +196,14 @@ def test_a_step_across_the_maximum_hits_the_target_under_its_own_control(monkeyp
     monkeypatch.setattr(_Follower, "_attempt", lambda self, *a, **k: arcs.append(1) or
                         real(self, *a, **k))
     monkeypatch.setattr(_Follower, "_chord_target", lambda *a, **k: pytest.fail("chord"))
+    goals = []
+    control = _Follower._control_to
+    monkeypatch.setattr(_Follower, "_control_to", lambda self, name, goal, *a: goals.append(goal)
+                        or control(self, name, goal, *a))
     hit, _, name = f._hit_crossed_target(trial, 1.0, last, t)
     assert name == "w2" and not arcs  # neither the chord nor regula falsi's arcs
+    # the first sub-increment covers half the distance (last's tangent, before the maximum)
+    assert math.isclose(goals[0], 0.5 * (last.u[1] + target), rel_tol=1e-12)
     # closed form: w2 = w1 + λ P / k is monotone in w1 here (k > max |f'|), λ P = f_bar(w1)
     from scipy.optimize import brentq
 
