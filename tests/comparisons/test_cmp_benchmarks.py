@@ -118,3 +118,19 @@ def test_tradeoff_variants_set_the_core_level(scene):
         bm = tradeoff.with_beam_elements(scene, 30, variant).beam_model
         assert (bm.core, bm.face_membrane, bm.elements, bm.faces, bm.contact_search) == (
             core, membrane, 30, faces, search), variant
+
+
+def test_tradeoff_warm_up_solves_each_model_once_at_the_cheapest_setting():
+    # the process's first 2D solve pays dolfinx's imports: warm_up runs it (and the beam) once,
+    # untimed, at the first level and the smallest element count, with the scene's until
+    calls = []
+
+    def beam(sc):
+        calls.append(("beam", sc.beam_model.elements, sc.analysis.until_value))
+
+    def ref(sc, level, refine):
+        calls.append(("2d", level, refine, sc.analysis.until_value))
+
+    tradeoff.warm_up("paper-fig4-bonded-3pb", "coarse", "L2", [240, 120],
+                     {"paper-fig4-bonded-3pb": -12.0}, beam, ref)
+    assert calls == [("2d", "coarse", 0, -12.0), ("beam", 120, -12.0)]
