@@ -63,6 +63,12 @@ RESCUE_MEMORY = 5  # accepted steps remembered for the rescue step's probe chang
 #: and the rest of the path once a corrector converged after rising so (docs/beam_speed.md,
 #: "Corrector attempts that diverge").
 DIVERGENCE_RISES = 2
+#: A step that crosses both a critical point and a stopping target, converging only after more
+#: than ``desired_iterations``, is cut and retried up to this many times (then accepted): the
+#: target is then approached by ordinary steps past the critical point (docs/solver.md, "The
+#: last step across a critical point").
+CRITICAL_TARGET_CUTS = 2
+CRITICAL_TARGET = "a hard step across a critical point and the target"  # that cut's reason
 
 
 @dataclass
@@ -397,9 +403,11 @@ class _Follower:
                        step: int) -> tuple[_Trial, float, bool, int] | str:
         """Try steps from ``last``, halving the increment on failure, with one probe rescue.
 
-        Returns the converged trial, its increment, whether it hit a controlled target
-        directly, and the number of cuts; or, when the increment would go below its floor, the
-        message saying where and why the path stops.
+        A converged trial across a critical point and the stopping target that needed more than
+        ``desired_iterations`` counts as a failure for its first ``CRITICAL_TARGET_CUTS`` tries
+        (:meth:`_hard_across_target`). Returns the converged trial, its increment, whether it
+        hit a controlled target directly, and the number of cuts; or, when the increment would
+        go below its floor, the message saying where and why the path stops.
         """
         opt = self.opt
         cuts = 0
@@ -410,6 +418,9 @@ class _Follower:
             if sign is not None:  # towards a directly controlled target
                 self.sigma = sign
             trial, reason = self._attempt(h_try, last, t, rises)
+            if trial is not None and cuts < CRITICAL_TARGET_CUTS and 0.5 * h_try >= size.h_min \
+                    and self._hard_across_target(last, trial):
+                trial, reason = None, CRITICAL_TARGET
             if trial is not None:
                 if 0 < DIVERGENCE_RISES <= trial.rises:
                     # a corrector that rose so converged: this model's iterations hunt (a contact
@@ -445,6 +456,24 @@ class _Follower:
                         f"{cuts} time(s), last to {h_try:.3g}, and may not go below "
                         f"min_increment = {size.h_min:.3g}; "
                         f"last reason: {reason}.{hint}")
+
+    def _hard_across_target(self, last: PathState, trial: _Trial) -> bool:
+        """Whether ``trial`` crossed a critical point and a stopping target, the hard way.
+
+        The tangent's inertia changed between ``last`` and ``trial``, the step passed the
+        ``until`` target, and the corrector needed more than ``desired_iterations``. Such a
+        step is shortened (:meth:`_converge_step`, at most ``CRITICAL_TARGET_CUTS`` times)
+        instead of being handed to :meth:`_hit_crossed_target`, whose target control from
+        ``last`` — before the critical point — can land on another equilibrium: fig. 7 c1 at
+        the paper's core, 120 elements, stepped from λ 556 (w −23.2 mm) to the target in one
+        step of 15 iterations and ended at λ 735.38, where the path in steps of at most 15
+        reaches −40 mm at λ 860.66 (and so does it with this cut, in 8 steps); at 40-480
+        elements the default steps and the short ones agree.
+        """
+        neg = last.negative_pivots
+        return (neg is not None and trial.factorization.negative_pivots != neg
+                and trial.iterations > self.opt.desired_iterations
+                and bool(self._crossings(last, trial)))
 
     def _finish_crossed(self, crossed: str) -> PathResult:
         """End of a path whose step crossed the target on ``crossed`` without hitting it."""
