@@ -5,13 +5,9 @@ whose tangent's inertia differs from the last state's, which passed the ``until`
 needed more than ``desired_iterations``: the target is then reached by ordinary steps past the
 critical point instead of by the target's control from before it. Toy: the von Mises truss
 behind a spring (its load maximum changes the inertia 0 → 1, tests/solver/solver_toys.py);
-the trial's iteration count is set by the test. Reference for the beam: fig. 7 c1 at the
-paper's core and 120 elements, whose end load must equal the path's in short steps (at most 15
-per step, where every step is easy) — before this guard it ended at another equilibrium.
+the trial's iteration count is set by the test. The beam's case (fig. 7 c1 at 120 elements):
+tests/beam_element/test_step_independence.py.
 """
-
-import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -99,22 +95,3 @@ def test_unknown_inertia_leaves_the_step_alone(monkeypatch):
     f.states = [last]
     (_, _, _, cuts), tried = _converge(monkeypatch, f, last, u1, lam1, fac1, 9)
     assert tried == [1.0] and cuts == 0
-
-
-def test_c1_at_120_elements_ends_where_its_path_in_short_steps_does():
-    from beam_element import run
-    from sandwich.scene_file import load_scene
-
-    scene = load_scene(Path(__file__).resolve().parents[2] / "scenes"
-                       / "paper-fig7-cantilever-c1.toml")
-    short = dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
-                                                                    max_increment=15.0))
-    ends = []
-    for sc in (scene, short):
-        result = run(sc, elements=120, model_options={"core_level": 1})
-        assert result.solution.converged
-        ends.append(result.states[-1].load_factor)
-    default, reference = ends
-    # the same equilibrium at w = −40 mm: to the target tolerance (1e-6), not another branch
-    # (735.38 before the guard, 860.66 in short steps)
-    assert default == pytest.approx(reference, rel=1e-6)
