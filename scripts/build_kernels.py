@@ -71,6 +71,16 @@ def _workload() -> None:
         envelope.factorize_envelope(Kt).solve(np.ones(model.size))
     finally:
         envelope.COLUMN_ADVANTAGE = saved
+    # a widening (contact pairs that come into contact along a path): a structure of the
+    # tangent's values with its couplings beyond 5 columns stored as zeros, then the tangent
+    # itself, whose values spill out of that envelope (envelope._pattern_union)
+    B = Kt.tocsr(copy=True)
+    far = np.abs(B.indices - np.repeat(np.arange(B.shape[0]), np.diff(B.indptr))) > 5
+    B.data[far] = 0.0
+    narrow = envelope.EnvelopeStructure.of(B, numeric=True)
+    widened = envelope.factorize_envelope(Kt, narrow)
+    if getattr(widened, "structure", narrow) is narrow:
+        raise RuntimeError("build workload: the widening case did not widen")
     u_full = model.expand(np.full(model.size, 1e-3))
     for op, _, els, dofs in model._families():
         K.layer_blocks(op, u_full[dofs], model.mesh.lengths[els], model.width)

@@ -347,13 +347,39 @@ class EnvelopeStructure:
 
 def _pattern_union(n: int, a: tuple[np.ndarray, np.ndarray],
                    b: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """CSR pattern (indptr, indices) of the union of two n × n patterns, sorted."""
-    def ones(p):
-        return sp.csr_matrix((np.ones(p[1].size), p[1], p[0]), shape=(n, n))
+    """CSR pattern (indptr, indices) of the union of two n × n patterns, sorted.
 
-    u = (ones(a) + ones(b)).tocsr()
-    u.sort_indices()
-    return u.indptr.astype(np.int64), u.indices.astype(np.int64)
+    Both patterns' rows must be sorted (canonical CSR, :func:`_values_pattern`'s, or an earlier
+    union): the rows are merged (:func:`_union_rows`), int64 throughout.
+    """
+    a_ptr, a_ind, b_ptr, b_ind = (np.ascontiguousarray(x, dtype=np.int64)
+                                  for x in (a[0], a[1], b[0], b[1]))
+    return _union_rows(n, a_ptr, a_ind, b_ptr, b_ind)
+
+
+@njit
+def _union_rows(n, a_ptr, a_ind, b_ptr, b_ind):  # pragma: no cover - compiled
+    """Row-by-row merge of two sorted CSR patterns into their sorted union (duplicates once)."""
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    out = np.empty(a_ind.size + b_ind.size, dtype=np.int64)
+    c = 0
+    for r in range(n):
+        i, i_end = a_ptr[r], a_ptr[r + 1]
+        j, j_end = b_ptr[r], b_ptr[r + 1]
+        last = -1
+        while i < i_end or j < j_end:
+            if j >= j_end or (i < i_end and a_ind[i] <= b_ind[j]):
+                v = a_ind[i]
+                i += 1
+            else:
+                v = b_ind[j]
+                j += 1
+            if v != last:
+                out[c] = v
+                c += 1
+                last = v
+        ptr[r + 1] = c
+    return ptr, out[:c]
 
 
 #: Storage arrays kept for reuse per structure (:meth:`EnvelopeStructure.storage_array`).

@@ -527,3 +527,25 @@ def test_panel_flop_count_against_a_panel_by_panel_count():
             R = int(last[j + w - 1])
             count += sum(16 * (R - k + 1) for k in range(j + w, R + 1))
         assert envelope._panel_flops(last) == count
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_pattern_union_is_the_rows_set_union(seed):
+    # reference: the per-row set union of two random sorted CSR patterns (empty rows, full rows,
+    # shared entries; int32 and int64 index arrays as scipy and _values_pattern give them)
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 40))
+
+    def pattern(dtype):
+        rows = [np.sort(rng.choice(n, size=int(rng.integers(0, n + 1)), replace=False))
+                for _ in range(n)]
+        ptr = np.concatenate([[0], np.cumsum([r.size for r in rows])]).astype(dtype)
+        ind = (np.concatenate(rows) if rows else np.empty(0)).astype(dtype)
+        return ptr, ind, rows
+
+    *a, ra = pattern(np.int32)
+    *b, rb = pattern(np.int64)
+    ptr, ind = envelope._pattern_union(n, tuple(a), tuple(b))
+    assert ptr.dtype == ind.dtype == np.int64 and ptr[0] == 0 and ptr[-1] == ind.size
+    for r in range(n):
+        assert ind[ptr[r]:ptr[r + 1]].tolist() == sorted(set(ra[r]) | set(rb[r]))
