@@ -760,6 +760,15 @@ def refinement_zones(scene: object) -> list[tuple[float, float]]:
     return [(d.start, d.end) for d in scene.debonds if d.end > d.start]
 
 
+def default_contact_smoothing(scene: object) -> float:
+    """The contact law's default regularisation width s (mm).
+
+    ``SMOOTHING_FRACTION`` × the allowed penetration (``PENETRATION_BOUND`` × the thinner face).
+    """
+    return SMOOTHING_FRACTION * PENETRATION_BOUND * min(float(scene.top.thickness),
+                                                        float(scene.bottom.thickness))
+
+
 def build_model(
     scene: object,
     *,
@@ -930,7 +939,7 @@ def build_model(
     if contact_penalty is None:
         contact_penalty = PENALTY_FACTOR * stiffness["core"][1, 1] / hc
     if contact_smoothing is None:
-        contact_smoothing = SMOOTHING_FRACTION * PENETRATION_BOUND * min(ht, hb)
+        contact_smoothing = default_contact_smoothing(scene)
     model = BeamModel(
         name=scene.name, mesh=mesh, width=float(scene.width), layers=layers, products=products,
         dof_map=dof_map, pairs=pairs, penalty=float(contact_penalty), f_ref_full=f_ref,

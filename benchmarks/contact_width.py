@@ -4,7 +4,7 @@ Run: ``.venv/bin/python benchmarks/contact_width.py [--scenes NAME ...] [--level
 [--factors 1 10]``. Writes ``benchmarks/results/beam/contact_width.{md,csv}``.
 
 The penalty law of a debonded interface (``beam_element.contact.pressure_law``) is regularised
-over a width s (default ``SMOOTHING_FRACTION × PENETRATION_BOUND × min(face thicknesses)``,
+over a width s (default ``beam_element.model.default_contact_smoothing``,
 1e-6 mm on the shipped scenes). Newton converges linearly on pairs in the law's exponential
 tail (docs/beam_speed.md, "What bounds the rest"), which sets the iteration count of every
 debond scene. This benchmark solves each scene in this process with s × each factor
@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from beam_element import run
-from beam_element.model import PENETRATION_BOUND, SMOOTHING_FRACTION, BeamModel
+from beam_element.model import BeamModel, default_contact_smoothing
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -36,8 +36,7 @@ COLUMNS = ["scene", "core", "factor", "width_mm", "wall_s", "steps", "iterations
 
 def solve(scene: object, level: str, factor: float) -> dict[str, object]:
     """One run at ``factor`` × the default width; its cost and end state."""
-    width = factor * SMOOTHING_FRACTION * PENETRATION_BOUND * min(scene.top.thickness,
-                                                                   scene.bottom.thickness)
+    width = factor * default_contact_smoothing(scene)
     options: dict[str, object] = {"contact_smoothing": width}
     if level != "auto":
         options["core_level"] = int(level)
