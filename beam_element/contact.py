@@ -374,6 +374,13 @@ def _cached_compact(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     return c
 
 
+def forget_kinematics(pairs: ContactPairs) -> None:
+    """Drop the closest-point kinematics kept for ``pairs`` (and their interface's parent)."""
+    for p in (pairs, pairs.parent):
+        if p is not None:
+            p.__dict__.pop("_last_compact", None)
+
+
 def _own_compact(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     """Closest-point kinematics of ``pairs`` on their chosen segments, in their own layout.
 

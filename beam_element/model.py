@@ -23,6 +23,7 @@ from beam_element.contact import (
     compact_response,
     contact_pair_groups,
     contact_state,
+    forget_kinematics,
     in_contact,
     penalty_response,
 )
@@ -352,6 +353,18 @@ class BeamModel:
             self.max_sliding_seen = max(self.max_sliding_seen, s.max_sliding)
 
     # --- evaluation -----------------------------------------------------------------------
+    def forget_evaluations(self) -> None:
+        """Drop what the last evaluation left for the next one at the same ``u``.
+
+        The model's cached force and tangent, and each contact interface's closest-point
+        kinematics (:func:`beam_element.contact.forget_kinematics`): the next call evaluates
+        in full, as a Newton iteration at a new iterate does. For benchmarks that time one
+        evaluation repeatedly at one state.
+        """
+        self._cache = None
+        for pairs in self.pairs:
+            forget_kinematics(pairs)
+
     def expand(self, u: np.ndarray) -> np.ndarray:
         """Full DOF vector (20 per node, then the core enrichment) of free DOFs ``u``."""
         u = np.asarray(u, dtype=float)

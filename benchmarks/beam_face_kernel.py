@@ -96,7 +96,7 @@ def face_evaluation(model, u_full, before):
 
 
 def full_evaluation(model, u):
-    model._cache = None  # a fresh evaluation, not the cached one
+    model.forget_evaluations()  # a fresh evaluation: layers and contact kinematics
     return model.tangent(u)
 
 

@@ -433,3 +433,28 @@ def test_remembered_compact_slots_add_the_same_sums_as_the_search():
         assert misses1 == misses0
         assert np.array_equal(d1, d0)
     assert misses0 > 0 and np.any(free < 0)  # both cases were met
+
+
+def test_forget_evaluations_makes_the_next_evaluation_a_full_one(monkeypatch):
+    """What the benchmarks time as one evaluation is one Newton iterate's: after
+    ``forget_evaluations`` the closest-point kinematics are computed again (at the same u they
+    are otherwise reused: a benchmark repeating one state would skip them), and the tangent
+    is the same matrix (the cache only saves work)."""
+    from beam_element import contact
+
+    scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
+    model = build_model(scene, contact_search="closest-point")
+    u = _contact_state(model, np.random.default_rng(5))
+    calls = []
+    projected = contact._compact_kinematics
+    monkeypatch.setattr(contact, "_compact_kinematics",
+                        lambda pairs, u_full: calls.append(1) or projected(pairs, u_full))
+    K0 = model.tangent(u).copy()
+    assert calls == [1]
+    model._cache = None  # the model's own cache alone: the kinematics are still reused
+    model.tangent(u)
+    assert calls == [1]
+    model.forget_evaluations()
+    K2 = model.tangent(u)
+    assert calls == [1, 1]
+    assert abs(K2 - K0).max() == 0.0
