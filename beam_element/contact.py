@@ -440,14 +440,31 @@ def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     if kernel is None or pairs.size == 0:
         return _compact_kinematics_numpy(pairs, u_full)
     v_face = u_full[pairs.dofs[:, :2]]  # (m, 2): u_face, w_face
-    core = u_full[pairs.support_dofs[:, 2:]].reshape(pairs.size, -1, 4)  # (m, S + 1, 4)
-    x_node = pairs.x[pairs.nodes]
-    out = kernel(np.ascontiguousarray(pairs.x[pairs.core_nodes]), np.ascontiguousarray(core),
+    x, node_dofs, core_nodes, valid = _kernel_geometry(pairs)
+    x_node = x[pairs.nodes]
+    out = kernel(x, u_full[node_dofs], core_nodes,  # every core node's (u, u_x, w, w_x)
                  np.ascontiguousarray(x_node + v_face[:, 0]), np.ascontiguousarray(v_face[:, 1]),
-                 np.ascontiguousarray(x_node), np.ascontiguousarray(pairs.segment_valid),
-                 NORMAL_SIGN[pairs.interface], PROJECTION_TOL, PROJECTION_MAX_ITERATIONS,
-                 PROJECTION_RESIDUAL_TOL, IN_SEGMENT_TOL)
+                 x_node, valid, NORMAL_SIGN[pairs.interface], PROJECTION_TOL,
+                 PROJECTION_MAX_ITERATIONS, PROJECTION_RESIDUAL_TOL, IN_SEGMENT_TOL)
     return _Compact(*out)
+
+
+def _kernel_geometry(pairs: ContactPairs) -> tuple[np.ndarray, ...]:
+    """The kernel's fixed inputs, formed once per pairs.
+
+    Node x, the core boundary DOFs of every node (n, 4) in CORE_NODE_ROLES order, the windows
+    and their valid segments.
+    """
+    cached = pairs.__dict__.get("_kernel_geometry")
+    if cached is None:
+        names = CONTACT_DOFS[pairs.interface]
+        every = np.arange(pairs.x.size)
+        node_dofs = np.stack([global_dof(every, names[r]) for r in CORE_NODE_ROLES], axis=-1)
+        cached = (np.ascontiguousarray(pairs.x, dtype=float), node_dofs,
+                  np.ascontiguousarray(pairs.core_nodes, dtype=np.int64),
+                  np.ascontiguousarray(pairs.segment_valid))
+        object.__setattr__(pairs, "_kernel_geometry", cached)
+    return cached
 
 
 def _compact_kinematics_numpy(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:

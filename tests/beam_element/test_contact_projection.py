@@ -442,3 +442,34 @@ def test_compiled_kinematics_match_the_numpy_reference(interface):
         np.testing.assert_allclose(a.sliding, b.sliding, rtol=0, atol=1e-12)
         np.testing.assert_allclose(a.grad, b.grad, rtol=0, atol=1e-10 * np.abs(b.grad).max())
         np.testing.assert_allclose(a.hess, b.hess, rtol=0, atol=1e-9 * np.abs(b.hess).max())
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_compiled_search_breaks_ties_as_the_exhaustive_one(interface):
+    """The kernel searches the segments nearest box first and stops at the first box farther
+    than its best projection; the NumPy path projects on every segment and takes the argmin.
+    Face nodes straight above (below) the core nodes of a flat core project exactly onto the
+    shared node of two segments (ξ = 1 on the left one, ξ = 0 on the right one, the same
+    distance): both must pick the left (lower) segment, for open pairs at several heights and
+    for a face slid by whole elements onto other nodes."""
+    from beam_element import contact
+
+    if contact._closest_point_kernel() is None:
+        pytest.skip("numba not installed: the NumPy path is the only one")
+    nodes = np.arange(1, XU.size - 1)
+    pairs = contact_pairs(interface, nodes, XU, 60.0, search="closest-point", reach=1.0)
+    names = CONTACT_DOFS[interface]
+    side = 1.0 if interface == "top" else -1.0
+    for shift, lift in ((0, 0.3), (0, 1e-3), (2, 0.05)):
+        u = np.zeros(NODE_DOFS * XU.size)
+        target = np.clip(nodes + shift, 0, XU.size - 1)  # onto another core node
+        u[global_dof(nodes, names["u_face"])] = XU[target] - XU[nodes]
+        u[global_dof(nodes, names["w_face"])] = side * lift
+        a = contact._compact_kinematics(pairs, u)
+        b = contact._compact_kinematics_numpy(pairs, u)
+        inner = (target > 0) & (target < XU.size - 1)
+        assert np.all(np.isin(a.xi[inner], (0.0, 1.0)))  # on a shared node: a tie
+        np.testing.assert_array_equal(a.segment, b.segment)
+        np.testing.assert_array_equal(a.xi, b.xi)
+        assert np.all(a.xi[inner] == 1.0)  # the left segment's end: the lower one won
+        np.testing.assert_allclose(a.gap, side * 0 + lift, rtol=1e-12)
