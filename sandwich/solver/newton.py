@@ -51,9 +51,12 @@ fig. 7 c4 at core level 3 puts 14-59 pairs 0.1-0.2 mm deep into the core in one 
 the residual grows by 400-1500×, the next corrections push them out and back in, and the step
 is cut — down to 0.08-0.17 mm of tip deflection (docs/beam_speed.md, "Contact-limited
 corrections"). Shortened so that no open pair goes deeper than the penetration bound, the
-correction leaves those pairs where the next tangent sees them. The equations and the
-convergence tests are unchanged (the converged state is an equilibrium of the same R); a
-shortened correction never counts for the increment test.
+correction leaves those pairs where the next tangent sees them. Only a corrector's first
+:data:`LIMITED_CORRECTIONS` corrections are limited (the overshoot comes from the predictor);
+later ones are plain Newton's, so that a pair stopped at the bound and pushed open again
+cannot keep a corrector cycling. The equations and the convergence tests are unchanged (the
+converged state is an equilibrium of the same R); a shortened correction never counts for the
+increment test.
 
 Divergence (reported as a failed :class:`NewtonResult`, never raised): a non-finite residual or
 iterate, a singular tangent, a constraint without solution, a residual grown by more than
@@ -88,6 +91,12 @@ _TINY = 1e-300
 
 #: The smallest fraction of a correction a system's ``correction_limit`` may shorten it to.
 MIN_CORRECTION_FRACTION = 1e-3
+#: Only a corrector's first corrections may be limited (those from the predictor, where the
+#: open pairs are carried in); later ones are plain Newton's, so that a pair stopped at the
+#: bound and pushed open again cannot keep the corrector cycling (fig. 6 at 40 elements, the
+#: paper's core: limited on every correction, its correctors cycled with period 2-3 at the
+#: face's load maximum and the path stopped there).
+LIMITED_CORRECTIONS = 3
 
 #: How the reason of a corrector stopped by the rising test begins.
 RISING = "residual rose"
@@ -262,7 +271,7 @@ def newton_correct(
                                 f"{settings.backtracks} halvings", it)
                 du, dlam, trial_force = searched
             shortened = False
-            if limit is not None and trial_force is None:
+            if limit is not None and trial_force is None and it < LIMITED_CORRECTIONS:
                 alpha = float(limit(u, du))
                 if alpha < 1.0:  # (not after a line search: its trial force is this du's)
                     alpha = max(alpha, MIN_CORRECTION_FRACTION)

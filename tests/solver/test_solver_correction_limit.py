@@ -13,7 +13,7 @@ from solver_toys import ToySystem
 
 from sandwich.solver import NewtonSettings, PathOptions, follow_path, solve_equilibrium
 from sandwich.solver import path as path_module
-from sandwich.solver.newton import MIN_CORRECTION_FRACTION, NewtonResult
+from sandwich.solver.newton import LIMITED_CORRECTIONS, MIN_CORRECTION_FRACTION, NewtonResult
 
 TOL = 1e-10
 
@@ -76,17 +76,21 @@ def test_the_limit_is_floored():
     assert s.iterates[1] == pytest.approx(MIN_CORRECTION_FRACTION * 0.5, rel=1e-12)
 
 
-def test_a_shortened_correction_never_passes_the_increment_test():
-    """Corrections always halved (the limit 0.5 at every iterate) shrink geometrically and the
-    residual with them, but a shortened correction says nothing about the remaining one: the
-    corrector must not declare convergence on it. Off the wall the toy is linear, so one full
-    correction would be exact."""
+def test_only_the_first_corrections_are_limited_and_never_count_as_small():
+    """Corrections halved by the limit (0.5 at every iterate) for the corrector's first
+    LIMITED_CORRECTIONS, then plain Newton's — exact on this linear stretch. Started within
+    1e-12 of the equilibrium, the first halved correction already leaves a residual and an
+    increment within the tolerances; the corrector must not stop on a shortened correction:
+    it converges after the first plain one, at u* to round-off."""
     s = SpringOnWall(fixed_limit=0.5)
-    settings = NewtonSettings(tol=TOL, max_iterations=60, limit_corrections=True)
-    r = solve_equilibrium(s, 0.5, np.zeros(1), settings)  # 60 halvings: ‖R‖ → 4e-19
-    assert not r.converged
-    assert "no convergence" in r.reason
-    assert _solve(SpringOnWall(fixed_limit=1.0), 0.5, True).converged
+    u_star = 0.5  # off the wall: u* = λ P / k
+    settings = NewtonSettings(tol=TOL, max_iterations=30, limit_corrections=True)
+    r = solve_equilibrium(s, u_star, np.array([u_star * (1 - 1e-12)]), settings)
+    assert r.converged
+    assert r.iterations == LIMITED_CORRECTIONS + 1
+    assert r.u[0] == pytest.approx(u_star, rel=1e-15)
+    steps = np.abs(u_star - np.array(s.iterates[:LIMITED_CORRECTIONS + 1]))
+    assert np.allclose(steps[1:] / steps[:-1], 0.5, rtol=1e-3)  # halved while limited
 
 
 def test_a_failed_corrector_turns_limits_on_for_the_rest_of_the_path(monkeypatch):
