@@ -379,6 +379,23 @@ def forget_kinematics(pairs: ContactPairs) -> None:
     for p in (pairs, pairs.parent):
         if p is not None:
             p.__dict__.pop("_last_compact", None)
+            p.__dict__.pop("_last", None)
+
+
+def gap_change(
+    pairs: ContactPairs, u_full: np.ndarray, du_full: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair's gap g at ``u_full`` and its linearised change ∂g/∂u · du along ``du_full``.
+
+    Closest-point pairs on their chosen segments (the projection at ``u_full`` is the one the
+    force evaluation there made, reused); same-x pairs on their six DOFs.
+    """
+    if pairs.search == "closest-point":
+        c = _own_compact(pairs, u_full)
+        dofs = np.take_along_axis(pairs.support_dofs, c.cols, axis=1)
+        return c.gap, np.einsum("ij,ij->i", c.grad, du_full[dofs])
+    k = pair_kinematics(pairs, u_full)
+    return k.gap, np.einsum("ij,ij->i", k.grad, du_full[pairs.block_dofs])
 
 
 def _own_compact(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:

@@ -19,11 +19,13 @@ from beam_element.constitutive import core_stiffness, face_stiffness
 from beam_element.constraints import DofMap, NodeSupport, build_dof_map
 from beam_element.contact import (
     DEFAULT_REACH,
+    SHIFT,
     ContactPairs,
     compact_response,
     contact_pair_groups,
     contact_state,
     forget_kinematics,
+    gap_change,
     in_contact,
     penalty_response,
 )
@@ -353,6 +355,29 @@ class BeamModel:
             self.max_sliding_seen = max(self.max_sliding_seen, s.max_sliding)
 
     # --- evaluation -----------------------------------------------------------------------
+    def correction_limit(self, u: np.ndarray, du: np.ndarray) -> float:
+        """Largest fraction α ≤ 1 of the correction ``du`` from ``u`` this model trusts.
+
+        A contact pair that is open at ``u`` or in the law's tail (g > −c s, :func:`pressure_law
+        <beam_element.contact.pressure_law>`: its stiffness below ε/2) has no contact stiffness
+        in the tangent the correction was solved with; α keeps every such pair's linearised gap
+        g + α ∂g/∂u·du at or above −``penetration_bound()``. Pairs already in the penalty's
+        linear range are left to Newton, exact there. Used by the corrector when the path
+        follower asks for it (:mod:`sandwich.solver.newton`, contact-limited corrections).
+        """
+        bound = self.penetration_bound()
+        tail = -SHIFT * self.smoothing
+        u_full, du_full = self.expand(u), self.expand(du)
+        alpha = 1.0
+        for pairs in self.pairs:
+            if pairs.size == 0:
+                continue
+            g, dg = gap_change(pairs, u_full, du_full)
+            deep = (g > tail) & (g + dg < -bound)
+            if np.any(deep):
+                alpha = min(alpha, float(np.min((g[deep] + bound) / -dg[deep])))
+        return alpha
+
     def forget_evaluations(self) -> None:
         """Drop what the last evaluation left for the next one at the same ``u``.
 

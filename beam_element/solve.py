@@ -67,7 +67,7 @@ PENALTY_GROWTH = 2.0
 # checked pass did not see (default scene, level 4 over the debond: a limit point at −6 mm the
 # 2D model does not have, 240+ steps), and the kept answer is then the checked pass, said so.
 CORE_RECHECKS = 3
-RERUN_STEP_FACTOR = 3
+RERUN_STEP_FACTOR = 4
 RERUN_MIN_STEPS = 30
 # Each raise is first tried on the checked pass's end state alone (solve._end_state): Newton
 # with up to END_STATE_BACKTRACKS halvings per correction, END_STATE_ITERATIONS corrections.

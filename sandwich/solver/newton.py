@@ -42,6 +42,22 @@ residual grows by 1e4) — the damped iterates descend until the quadratic phase
 full steps. A probe or load constraint stays satisfied to first order: each iteration's δλ is
 recomputed from the current iterate.
 
+Contact-limited corrections (``limit_corrections``, off by default; the path follower turns it
+on for the rest of a path once one of its correctors has failed, ``sandwich/solver/path.py``):
+a system with ``correction_limit(u, du)`` may shorten a correction to the fraction α it returns
+(at least :data:`MIN_CORRECTION_FRACTION`). Where a contact pair is open, the tangent carries no
+contact stiffness for it, and a correction that closes it is blind to the penalty it meets:
+fig. 7 c4 at core level 3 puts 14-59 pairs 0.1-0.2 mm deep into the core in one correction,
+the residual grows by 400-1500×, the next corrections push them out and back in, and the step
+is cut — down to 0.08-0.17 mm of tip deflection (docs/beam_speed.md, "Contact-limited
+corrections"). Shortened so that no open pair goes deeper than the penetration bound, the
+correction leaves those pairs where the next tangent sees them. Only a corrector's first
+:data:`LIMITED_CORRECTIONS` corrections are limited (the overshoot comes from the predictor);
+later ones are plain Newton's, so that a pair stopped at the bound and pushed open again
+cannot keep a corrector cycling. The equations and the convergence tests are unchanged (the
+converged state is an equilibrium of the same R); a shortened correction never counts for the
+increment test.
+
 Divergence (reported as a failed :class:`NewtonResult`, never raised): a non-finite residual or
 iterate, a singular tangent, a constraint without solution, a residual grown by more than
 ``divergence_factor`` over the first one, a residual that rose ``divergence_rises`` times in a
@@ -73,6 +89,15 @@ __all__ = ["RISING", "NewtonResult", "NewtonSettings", "newton_correct", "solve_
 
 _TINY = 1e-300
 
+#: The smallest fraction of a correction a system's ``correction_limit`` may shorten it to.
+MIN_CORRECTION_FRACTION = 1e-3
+#: Only a corrector's first corrections may be limited (those from the predictor, where the
+#: open pairs are carried in); later ones are plain Newton's, so that a pair stopped at the
+#: bound and pushed open again cannot keep the corrector cycling (fig. 6 at 40 elements, the
+#: paper's core: limited on every correction, its correctors cycled with period 2-3 at the
+#: face's load maximum and the path stopped there).
+LIMITED_CORRECTIONS = 3
+
 #: How the reason of a corrector stopped by the rising test begins.
 RISING = "residual rose"
 
@@ -95,6 +120,7 @@ class NewtonSettings:
     divergence_factor: float = 1e4
     divergence_rises: int = 0  # consecutive rises above the first residual that fail (0: off)
     backtracks: int = 0  # halvings of a correction that does not lower ‖R‖ (0: plain Newton)
+    limit_corrections: bool = False  # shorten corrections to the system's correction_limit
 
 
 @dataclass
@@ -175,6 +201,7 @@ def newton_correct(
 
     trial_force = None  # f_int at the iterate, when the line search has evaluated it
     nearby = getattr(system, "internal_force_nearby", None)
+    limit = getattr(system, "correction_limit", None) if settings.limit_corrections else None
     small_step = False  # the last correction passed the increment test
     with np.errstate(all="ignore"):
         for it in range(settings.max_iterations + 1):
@@ -243,9 +270,16 @@ def newton_correct(
                     return fail(f"no decrease of the residual along the correction in "
                                 f"{settings.backtracks} halvings", it)
                 du, dlam, trial_force = searched
+            shortened = False
+            if limit is not None and trial_force is None and it < LIMITED_CORRECTIONS:
+                alpha = float(limit(u, du))
+                if alpha < 1.0:  # (not after a line search: its trial force is this du's)
+                    alpha = max(alpha, MIN_CORRECTION_FRACTION)
+                    du, dlam, shortened = alpha * du, alpha * dlam, True
             u = u + du
             lam = lam + dlam
-            last_step = _norm(du, dlam, psi, dot)
+            # a shortened correction says nothing about the remaining one: never "small"
+            last_step = math.inf if shortened else _norm(du, dlam, psi, dot)
     return fail(
         f"no convergence in {settings.max_iterations} iterations (residual {r_norm:.3e})",
         settings.max_iterations,

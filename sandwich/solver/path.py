@@ -28,6 +28,10 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
   one (``DIVERGENCE_RISES``): the step is cut, and its retries run without that test (an
   iteration hunting for its contact set may rise so and still converge); once a corrector has
   converged after rising so, the test is off for the rest of the path;
+- from its first failed corrector on, the path asks for contact-limited corrections
+  (``LIMIT_AFTER_FAILURE``, ``NewtonSettings.limit_corrections``: a system with
+  ``correction_limit(u, du)`` shortens a correction that would carry open contact pairs deep
+  into the core, :mod:`sandwich.solver.newton`);
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
   (it never grows after a cut step) and is clipped to [min_increment, max_increment].
@@ -47,7 +51,13 @@ import numpy as np
 from sandwich.results import LimitPoint
 from sandwich.solver.controls import ArcLengthConstraint, LoadConstraint, ProbeConstraint
 from sandwich.solver.limits import find_limit_points
-from sandwich.solver.newton import RECOVERABLE_ERRORS, RISING, NewtonSettings, newton_correct
+from sandwich.solver.newton import (
+    RECOVERABLE_ERRORS,
+    RISING,
+    NewtonResult,
+    NewtonSettings,
+    newton_correct,
+)
 from sandwich.solver.system import DiscreteSystem, Factorization, inner_product
 
 __all__ = ["PathOptions", "PathResult", "PathState", "follow_path", "solve_linear"]
@@ -63,6 +73,10 @@ RESCUE_MEMORY = 5  # accepted steps remembered for the rescue step's probe chang
 #: and the rest of the path once a corrector converged after rising so (docs/beam_speed.md,
 #: "Corrector attempts that diverge").
 DIVERGENCE_RISES = 2
+#: Contact-limited corrections (``NewtonSettings.limit_corrections``, for a system with
+#: ``correction_limit``) from the first failed corrector of a path on (docs/solver.md,
+#: "Contact-limited corrections").
+LIMIT_AFTER_FAILURE = True
 #: A step that crosses both a critical point and a stopping target, converging only after more
 #: than ``desired_iterations``, is cut and retried up to this many times (then accepted): the
 #: target is then approached by ordinary steps past the critical point (docs/solver.md, "The
@@ -263,6 +277,8 @@ class _StepSize:
 class _Follower:
     """State machine of :func:`follow_path` (one instance per call)."""
 
+    limit_corrections = False  # contact-limited corrections, on once a corrector has failed
+
     def __init__(
         self,
         system: DiscreteSystem,
@@ -413,11 +429,13 @@ class _Follower:
         cuts = 0
         rescued = False
         rises = self.divergence_rises  # the corrector's rising test, until it has cut this step
+        limited_failed = False  # a limited attempt of this step failed: the rest without
         while True:
             h_try, direct, sign = self._clip_to_target(size.h, last)
             if sign is not None:  # towards a directly controlled target
                 self.sigma = sign
-            trial, reason = self._attempt(h_try, last, t, rises)
+            limit = self.limit_corrections and not limited_failed
+            trial, reason = self._attempt(h_try, last, t, rises, limit)
             if trial is not None and cuts < CRITICAL_TARGET_CUTS and 0.5 * h_try >= size.h_min \
                     and self._hard_across_target(last, trial):
                 trial, reason = None, CRITICAL_TARGET
@@ -429,6 +447,9 @@ class _Follower:
                 return trial, h_try, direct, cuts
             if reason.startswith(RISING):
                 rises = 0
+            # a limited corrector can stall where the plain one converges (fig. 6 at 40
+            # elements: the arc's equation without a real root at a shortened iterate)
+            limited_failed = limited_failed or limit
             size.h = 0.5 * h_try
             cuts += 1
             if not rescued and self._rescue_due(cuts, size.h):
@@ -550,12 +571,13 @@ class _Follower:
             return math.copysign(1.0, dl) * (-1.0 if flips else 1.0)
         return math.copysign(1.0, dot) if dot != 0.0 else self.sigma
 
-    def _attempt(self, h: float, last: PathState, t: np.ndarray,
-                 rises: int = 0) -> tuple[_Trial | None, str]:
+    def _attempt(self, h: float, last: PathState, t: np.ndarray, rises: int = 0,
+                 limit: bool | None = None) -> tuple[_Trial | None, str]:
         """One predictor–corrector step of size ``h`` from ``last``.
 
         ``rises``: the corrector's ``divergence_rises`` (0: off, as for the target's and the
-        rescue's correctors, whose failure ends their search).
+        rescue's correctors, whose failure ends their search). ``limit``: contact-limited
+        corrections (default: the path's :attr:`limit_corrections`).
         """
         opt = self.opt
         if opt.control == "load":
@@ -585,9 +607,8 @@ class _Follower:
             if pred_len > opt.max_predictor_growth * prev_len:
                 return None, (f"predictor {pred_len:.3g} longer than {opt.max_predictor_growth}"
                               f" × the previous step {prev_len:.3g}")
-        settings = self._newton_settings(rises)
-        res = newton_correct(self.system, last.u + du_pred, last.load_factor + dlam, constraint,
-                             settings, last.u, last.load_factor)
+        res = self._correct(last.u + du_pred, last.load_factor + dlam, constraint,
+                            self._newton_settings(rises, limit), last.u, last.load_factor)
         if not res.converged or res.factorization is None:
             return None, res.reason
         dist = self.wnorm(res.u - last.u - du_pred, res.load_factor - last.load_factor - dlam)
@@ -604,15 +625,34 @@ class _Follower:
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization,
                       res.rises), "converged"
 
-    def _newton_settings(self, rises: int = 0) -> NewtonSettings:
+    def _newton_settings(self, rises: int = 0, limit: bool | None = None) -> NewtonSettings:
         """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far.
 
-        ``rises``: the rising test's ``divergence_rises`` (0: off).
+        ``rises``: the rising test's ``divergence_rises`` (0: off). ``limit``: contact-limited
+        corrections; by default as the path has them (on once a corrector of this path has
+        failed, :meth:`_correct`).
         """
         floor = (math.sqrt(self.dot(self.f_ref, self.f_ref))
                  * max(abs(s.load_factor) for s in self.states))
         return NewtonSettings(tol=self.opt.tol, max_iterations=self.opt.max_iterations,
-                              psi=self.psi, force_floor=floor, divergence_rises=rises)
+                              psi=self.psi, force_floor=floor, divergence_rises=rises,
+                              limit_corrections=(self.limit_corrections if limit is None
+                                                 else limit))
+
+    def _correct(self, u: np.ndarray, lam: float, constraint: object, settings: NewtonSettings,
+                 u_start: np.ndarray, lam_start: float) -> NewtonResult:
+        """:func:`~sandwich.solver.newton.newton_correct` on this path's system.
+
+        The first corrector that fails turns contact-limited corrections on for the rest of
+        the path (``LIMIT_AFTER_FAILURE``): a path whose corrector has failed once is one
+        whose contact pairs open and close under it (fig. 7 c3/c4, fig. 6), and on the paths
+        where no corrector fails (most of fig. 9, fig. 4, the paper's core on fig. 5) the
+        correctors stay as they were.
+        """
+        res = newton_correct(self.system, u, lam, constraint, settings, u_start, lam_start)
+        if not res.converged and LIMIT_AFTER_FAILURE:
+            self.limit_corrections = True
+        return res
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
@@ -794,8 +834,8 @@ class _Follower:
         lam0 = last.load_factor + frac * (trial.load_factor - last.load_factor)
         constraint = (LoadConstraint(target) if name == "λ"
                       else ProbeConstraint(self.c[name], target, self.dot))
-        res = newton_correct(self.system, u0, lam0, constraint, self._newton_settings(),
-                             last.u, last.load_factor)
+        res = self._correct(u0, lam0, constraint, self._newton_settings(), last.u,
+                            last.load_factor)
         if not res.converged or res.factorization is None:
             return None
         reach = self.wnorm(u0 - last.u, lam0 - last.load_factor)
@@ -863,8 +903,8 @@ class _Follower:
                 return None
             dlam = (goal - self.dot(c, u)) / ct
             constraint = ProbeConstraint(c, goal, self.dot)
-        res = newton_correct(self.system, u + dlam * t, lam + dlam, constraint,
-                             self._newton_settings(), u, lam)
+        res = self._correct(u + dlam * t, lam + dlam, constraint, self._newton_settings(), u,
+                            lam)
         if not res.converged or res.factorization is None:
             return None
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization)

@@ -29,6 +29,13 @@ A system may also provide ``internal_force_only(u)``: f_int(u), exactly as
 (the beam assembles its tangent in the same pass as the force). The line search asks for its
 halved trials through it: most of them are rejected, and the one accepted is evaluated again,
 in full, when its tangent is asked for.
+
+A system may also provide ``correction_limit(u, du) -> float``: the largest fraction α ∈ (0, 1]
+of a Newton correction ``du`` from ``u`` that the model's linearisation can be trusted with
+(the beam: no contact pair that is open at ``u``, where its tangent has no contact stiffness,
+may be carried deeper into the core than the penetration bound along its linearised gap). The
+corrector shortens a correction to that fraction where the path follower asks it to
+(``NewtonSettings.limit_corrections``, :mod:`sandwich.solver.newton`).
 """
 
 from __future__ import annotations

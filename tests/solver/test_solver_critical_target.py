@@ -55,7 +55,7 @@ def _converge(monkeypatch, f, last, u1, lam1, fac1, iterations):
     """``_converge_step`` with every attempt converging to the same trial; the sizes tried."""
     tried = []
 
-    def attempt(self, h, last_, t, rises=0):
+    def attempt(self, h, last_, t, rises=0, limit=None):
         tried.append(h)
         return _Trial(u1, lam1, iterations, fac1), "converged"
 
