@@ -447,8 +447,9 @@ class _Follower:
                 return trial, h_try, direct, cuts
             if reason.startswith(RISING):
                 rises = 0
-            # a limited corrector can stall where the plain one converges (fig. 6 at 40
-            # elements: the arc's equation without a real root at a shortened iterate)
+            # a failed limited attempt: the step's retries run plain, as before the limit
+            # (as the rising test's do; a shortened iterate can leave the arc's equation
+            # without a real root where a plain correction would not)
             limited_failed = limited_failed or limit
             size.h = 0.5 * h_try
             cuts += 1

@@ -97,13 +97,13 @@ def test_a_failed_corrector_turns_limits_on_for_the_rest_of_the_path(monkeypatch
     """The path follower asks for limited corrections once one of its correctors has failed,
     for every corrector after it; a path whose correctors all converge never asks."""
 
-    def run(fail_call):
+    def run(*fail_calls):
         seen = []
         real = path_module.newton_correct
 
         def spy(system, u, lam, constraint, settings, *args):
             seen.append(settings.limit_corrections)
-            if len(seen) == fail_call:
+            if len(seen) in fail_calls:
                 return NewtonResult(False, np.array(u, dtype=float), lam, 1, 1.0, "scripted")
             return real(system, u, lam, constraint, settings, *args)
 
@@ -114,7 +114,26 @@ def test_a_failed_corrector_turns_limits_on_for_the_rest_of_the_path(monkeypatch
         assert result.reached_target
         return seen
 
-    assert not any(run(fail_call=0))  # no failure: never asked
-    seen = run(fail_call=3)
+    assert not any(run())  # no failure: never asked
+    seen = run(3)
     assert seen[:3] == [False, False, False]
     assert len(seen) > 4 and all(seen[3:])
+
+
+def test_a_step_whose_limited_attempt_failed_is_retried_without_the_limit(monkeypatch):
+    """Within one step, a failed limited attempt sends the step's further attempts back to
+    plain corrections (as the rising test's retries); the next step is limited again."""
+    seen = []
+    real = path_module.newton_correct
+
+    def spy(system, u, lam, constraint, settings, *args):
+        seen.append(settings.limit_corrections)
+        if len(seen) in (3, 4):  # step 3 fails plain, then its limited retry fails too
+            return NewtonResult(False, np.array(u, dtype=float), lam, 1, 1.0, "scripted")
+        return real(system, u, lam, constraint, settings, *args)
+
+    monkeypatch.setattr(path_module, "newton_correct", spy)
+    opts = PathOptions(control="load", until_load_factor=3.0, initial_increment=0.5,
+                       max_increment=0.5, tol=TOL)
+    assert follow_path(SpringOnWall(), opts, ["u"]).reached_target
+    assert seen[:6] == [False, False, False, True, False, True]
