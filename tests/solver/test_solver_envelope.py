@@ -549,3 +549,28 @@ def test_pattern_union_is_the_rows_set_union(seed):
     assert ptr.dtype == ind.dtype == np.int64 and ptr[0] == 0 and ptr[-1] == ind.size
     for r in range(n):
         assert ind[ptr[r]:ptr[r + 1]].tolist() == sorted(set(ra[r]) | set(rb[r]))
+
+
+def test_a_structure_matches_its_pattern_through_new_views_and_copies_only():
+    """``EnvelopeStructure.matches``: a CSR matrix built on the structure's index arrays (scipy
+    hands it new views of them) matches without a comparison; an equal copy matches by
+    comparison; another pattern of the same size, or a view of the same memory with another
+    shape, does not."""
+    rng = np.random.default_rng(7)
+    K = _variable_band(rng, 40, rng.integers(1, 5, size=40))
+    s = EnvelopeStructure.of(K)
+    on_it = sp.csr_matrix((rng.normal(size=s.indices.size), s.indices, s.indptr), shape=K.shape)
+    assert on_it.indices is not s.indices  # the case the memory test is for
+    assert envelope._same_memory(on_it.indices, s.indices)
+    assert s.matches(on_it)
+    copied = sp.csr_matrix((on_it.data, s.indices.copy(), s.indptr.copy()), shape=K.shape)
+    assert not envelope._same_memory(copied.indices, s.indices)
+    assert s.matches(copied)
+    other = copied.copy()  # the same sizes, one column moved: row 0's last entry one further
+    row0 = other.indices[other.indptr[0]:other.indptr[1]]
+    assert row0[-1] + 1 < K.shape[0] and row0[-1] + 1 not in row0
+    row0[-1] += 1
+    assert not np.array_equal(other.indices, s.indices)
+    assert not s.matches(other)
+    assert not envelope._same_memory(s.indices[:-1], s.indices)
+    assert not envelope._same_memory(s.indices[::2], s.indices[:s.indices.size // 2 + 1])
