@@ -172,6 +172,7 @@ class Analysis:
     max_increment: float | None = None
     tol: float = 1e-8
     max_iterations: int = 25
+    settling_allowance: int | None = None  # step-size control (docs/solver.md): None = off
 
 
 @dataclass(frozen=True)

@@ -423,7 +423,8 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
 def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     key = "analysis"
     t = r.table(tbl, key, ("kind", "control", "until", "max_steps", "initial_increment",
-                           "min_increment", "max_increment", "tol", "max_iterations"),
+                           "min_increment", "max_increment", "tol", "max_iterations",
+                           "settling_allowance"),
                 required=("kind", "until"))
     if t is None:
         return Analysis()
@@ -469,10 +470,12 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
         r.fail("analysis.tol", f"{tol:g} is below round-off: Newton cannot reach it "
                f"(use >= {MIN_TOL:g})")
     max_it = r.integer(t, "max_iterations", key, default=d.max_iterations, lo=1, hi=1000)
+    settle = r.integer(t, "settling_allowance", key, default=None, lo=0, hi=1000)
     return Analysis(kind=kind or d.kind, control=control or d.control, until_probe=until_probe,
                     until_value=until_value, until_load_factor=until_lf,
                     max_steps=max_steps or d.max_steps, initial_increment=inc, min_increment=lo,
-                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations)
+                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations,
+                    settling_allowance=settle)
 
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:

@@ -140,6 +140,7 @@ class NewtonResult:
     reason: str
     factorization: Factorization | None = None
     rises: int = 0  # the longest run of rises above the first residual (the rising test's count)
+    increment_iterations: int | None = None  # iterations until the increment test first passed
 
 
 def _norm(v: np.ndarray, lam: float, psi: float, dot=None) -> float:
@@ -203,6 +204,7 @@ def newton_correct(
     nearby = getattr(system, "internal_force_nearby", None)
     limit = getattr(system, "correction_limit", None) if settings.limit_corrections else None
     small_step = False  # the last correction passed the increment test
+    first_small = None  # the iteration at which it first did
     with np.errstate(all="ignore"):
         for it in range(settings.max_iterations + 1):
             if trial_force is None:
@@ -223,6 +225,8 @@ def newton_correct(
             if last_step is not None:
                 inc_scale = max(_norm(u - u0, lam - lam0, psi, dot), _norm(u, lam, psi, dot))
                 small_step = last_step <= tol_inc * inc_scale
+                if small_step and first_small is None:
+                    first_small = it
                 how = ""
                 if small_step and r_norm <= settings.tol * scale:
                     how = "converged"
@@ -236,7 +240,8 @@ def newton_correct(
                         fac = system.factorize(system.tangent(u))
                     except RECOVERABLE_ERRORS as exc:
                         return fail(f"tangent at the converged state is singular: {exc}", it)
-                    return NewtonResult(True, u, lam, it, r_norm, how, fac, most_rises)
+                    return NewtonResult(True, u, lam, it, r_norm, how, fac, most_rises,
+                                        first_small)
             if r_first is None:
                 r_first = max(r_norm, settings.tol * scale)
             elif r_norm > settings.divergence_factor * r_first:

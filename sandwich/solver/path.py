@@ -34,7 +34,10 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
   into the core, :mod:`sandwich.solver.newton`);
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
-  (it never grows after a cut step) and is clipped to [min_increment, max_increment].
+  (it never grows after a cut step) and is clipped to [min_increment, max_increment]. With
+  ``settling_allowance`` k (off unless a scene asks for it), ``iterations`` is at most the
+  corrector's iterations until its increment test first passed plus k, as long as no
+  corrector of the path has failed (docs/solver.md, "Settling iterations").
 
 ψ (:attr:`PathOptions.arc_load_weight` × ``‖K(0)⁻¹ f_ref‖``) converts λ into displacement units,
 so in the linear range the λ and u parts of the arc weigh the same.
@@ -110,6 +113,11 @@ class PathOptions:
         Newton corrections allowed per step.
     desired_iterations
         Iteration count for which the increment is kept; fewer grow it, more shrink it.
+    settling_allowance
+        ``None`` (default): the controller weighs a step by all its corrector's iterations.
+        A number k (a scene's ``analysis.settling_allowance``): until the path's first failed
+        corrector, by at most the iterations its increment test took to pass plus k (module
+        docstring, step size; docs/solver.md "Settling iterations").
     control_probe
         Probe driven under displacement control (default: :attr:`until_probe`).
     arc_load_weight
@@ -145,6 +153,7 @@ class PathOptions:
     tol: float = 1e-8
     max_iterations: int = 25
     desired_iterations: int = 5
+    settling_allowance: int | None = None
     control_probe: str | None = None
     arc_load_weight: float = 1.0
     max_correction_ratio: float = 1.0
@@ -162,7 +171,8 @@ class PathOptions:
         increment floor, ``desired_iterations``); ``None`` values among them are kept.
         """
         names = ("control", "until_load_factor", "until_probe", "until_value", "max_steps",
-                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations")
+                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations",
+                 "settling_allowance")
         return cls(**{**{n: getattr(analysis, n) for n in names}, **overrides})
 
     def __post_init__(self) -> None:
@@ -178,6 +188,9 @@ class PathOptions:
             raise ValueError("until_value = 0 is the initial state")
         if self.max_steps < 1 or self.max_iterations < 1 or self.desired_iterations < 1:
             raise ValueError("max_steps, max_iterations and desired_iterations must be >= 1")
+        if self.settling_allowance is not None and self.settling_allowance < 0:
+            raise ValueError(f"settling_allowance must be >= 0 or None, got "
+                             f"{self.settling_allowance}")
         if not -1.0 <= self.min_step_cosine < 1.0:
             raise ValueError(f"min_step_cosine must be in [-1, 1), got {self.min_step_cosine}")
 
@@ -228,6 +241,7 @@ class _Trial:
     iterations: int
     factorization: Factorization
     rises: int = 0  # the corrector's longest run of rises above its first residual
+    increment_iterations: int | None = None  # until its increment test first passed
 
 
 def _fmt_probes(probes: dict[str, float]) -> str:
@@ -278,6 +292,7 @@ class _Follower:
     """State machine of :func:`follow_path` (one instance per call)."""
 
     limit_corrections = False  # contact-limited corrections, on once a corrector has failed
+    failed_once = False  # a corrector of this path has failed
 
     def __init__(
         self,
@@ -409,7 +424,7 @@ class _Follower:
                 return self.finish(True, done)
             if crossed:
                 return self._finish_crossed(crossed)
-            size.after(h_try, trial.iterations, cuts)
+            size.after(h_try, self._weighed_iterations(trial), cuts)
         s = self.states[-1]
         return self.finish(False, (
             f"max_steps = {opt.max_steps} reached at λ = {s.load_factor:.6g} "
@@ -624,7 +639,7 @@ class _Follower:
             if why:
                 return None, f"{INADMISSIBLE}: {why}"
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization,
-                      res.rises), "converged"
+                      res.rises, res.increment_iterations), "converged"
 
     def _newton_settings(self, rises: int = 0, limit: bool | None = None) -> NewtonSettings:
         """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far.
@@ -651,9 +666,25 @@ class _Follower:
         correctors stay as they were.
         """
         res = newton_correct(self.system, u, lam, constraint, settings, u_start, lam_start)
-        if not res.converged and LIMIT_AFTER_FAILURE:
-            self.limit_corrections = True
+        if not res.converged:
+            self.failed_once = True
+            if LIMIT_AFTER_FAILURE:
+                self.limit_corrections = True
         return res
+
+    def _weighed_iterations(self, trial: _Trial) -> int:
+        """The iterations the step-size controller weighs a converged step by.
+
+        All of them, unless :attr:`PathOptions.settling_allowance` is set and no corrector of
+        this path has failed: then at most the iterations until the increment test first
+        passed plus that allowance (the others settle a residual while the state no longer
+        moves — the beam's contact pairs in the penalty law's knee — and do not shrink with
+        the step).
+        """
+        k = self.opt.settling_allowance
+        if k is None or self.failed_once or trial.increment_iterations is None:
+            return trial.iterations
+        return min(trial.iterations, trial.increment_iterations + k)
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
