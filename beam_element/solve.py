@@ -658,7 +658,9 @@ def _follow(
     a = scene.analysis
     caps = {} if max_steps is None else {"max_steps": int(max_steps)}
     options = PathOptions.from_analysis(a, min_increment=_min_increment(model, a),
-                                        desired_iterations=DESIRED_ITERATIONS, **caps)
+                                        desired_iterations=DESIRED_ITERATIONS,
+                                        settling_allowance=scene.beam_model.settling_allowance,
+                                        **caps)
     result = follow_path(model, options, list(model.probe_rows), progress)
     states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes),
                              dict(s.extra)) for s in result.states]

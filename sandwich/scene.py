@@ -172,7 +172,6 @@ class Analysis:
     max_increment: float | None = None
     tol: float = 1e-8
     max_iterations: int = 25
-    settling_allowance: int | None = None  # step-size control (docs/solver.md): None = off
 
 
 @dataclass(frozen=True)
@@ -196,6 +195,7 @@ class BeamModelOptions:
     tolerance: float = 0.01  # "auto": target relative error of the core's through-thickness field
     max_core_level: int = 3  # "auto": highest level it may choose (docs/beam_element.md)
     core_zones: tuple[CoreZone, ...] = ()  # explicit levels over stretches of x
+    settling_allowance: int | None = None  # step sizes (docs/solver.md "Settling iterations")
 
 
 @dataclass(frozen=True)

@@ -423,8 +423,7 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
 def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     key = "analysis"
     t = r.table(tbl, key, ("kind", "control", "until", "max_steps", "initial_increment",
-                           "min_increment", "max_increment", "tol", "max_iterations",
-                           "settling_allowance"),
+                           "min_increment", "max_increment", "tol", "max_iterations"),
                 required=("kind", "until"))
     if t is None:
         return Analysis()
@@ -470,12 +469,10 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
         r.fail("analysis.tol", f"{tol:g} is below round-off: Newton cannot reach it "
                f"(use >= {MIN_TOL:g})")
     max_it = r.integer(t, "max_iterations", key, default=d.max_iterations, lo=1, hi=1000)
-    settle = r.integer(t, "settling_allowance", key, default=None, lo=0, hi=1000)
     return Analysis(kind=kind or d.kind, control=control or d.control, until_probe=until_probe,
                     until_value=until_value, until_load_factor=until_lf,
                     max_steps=max_steps or d.max_steps, initial_increment=inc, min_increment=lo,
-                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations,
-                    settling_allowance=settle)
+                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations)
 
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
@@ -483,7 +480,7 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
     t = r.table(tbl, key, ("elements", "grading", "face_membrane", "faces", "contact_search",
                            "gauss_x", "gauss_z",
                            "contact_penalty", "profile_every", "core", "core_basis", "tolerance",
-                           "max_core_level", "core_zones"))
+                           "max_core_level", "core_zones", "settling_allowance"))
     if t is None:
         return BeamModelOptions()
     d = BeamModelOptions()
@@ -532,6 +529,8 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
         profile_every=r.integer(t, "profile_every", key, default=0, lo=0) or 0,
+        settling_allowance=r.integer(t, "settling_allowance", key, default=None, lo=0,
+                                     hi=1000),
     )
 
 

@@ -35,7 +35,7 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
   (it never grows after a cut step) and is clipped to [min_increment, max_increment]. With
-  ``settling_allowance`` k (off unless a scene asks for it), ``iterations`` is at most the
+  ``settling_allowance`` k (off unless a model sets it), ``iterations`` is at most the
   corrector's iterations until its increment test first passed plus k, as long as no
   corrector of the path has failed (docs/solver.md, "Settling iterations").
 
@@ -115,9 +115,9 @@ class PathOptions:
         Iteration count for which the increment is kept; fewer grow it, more shrink it.
     settling_allowance
         ``None`` (default): the controller weighs a step by all its corrector's iterations.
-        A number k (a scene's ``analysis.settling_allowance``): until the path's first failed
-        corrector, by at most the iterations its increment test took to pass plus k (module
-        docstring, step size; docs/solver.md "Settling iterations").
+        A number k (the beam's ``[beam_model] settling_allowance``): until the path's first
+        failed corrector, by at most the iterations its increment test took to pass plus k
+        (module docstring, step size; docs/solver.md "Settling iterations").
     control_probe
         Probe driven under displacement control (default: :attr:`until_probe`).
     arc_load_weight
@@ -171,8 +171,7 @@ class PathOptions:
         increment floor, ``desired_iterations``); ``None`` values among them are kept.
         """
         names = ("control", "until_load_factor", "until_probe", "until_value", "max_steps",
-                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations",
-                 "settling_allowance")
+                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations")
         return cls(**{**{n: getattr(analysis, n) for n in names}, **overrides})
 
     def __post_init__(self) -> None:
