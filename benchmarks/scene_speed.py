@@ -30,6 +30,7 @@ import os
 import subprocess
 import tempfile
 import time
+import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -49,12 +50,12 @@ def solve(scene: Path, model: str, timeout: float, paper_core: bool = False) -> 
         path = scene
         if paper_core:
             text = scene.read_text()
-            if "core =" in text.split("[beam_model]", 1)[-1].split("\n[", 1)[0] \
-                    and "[beam_model]" in text:
+            table = tomllib.loads(text).get("beam_model")
+            if table is not None and "core" in table:
                 raise SystemExit(f"{scene}: its [beam_model] sets core; this script sets it")
             path = Path(tmp) / scene.name
-            path.write_text(text.replace("[beam_model]\n", "[beam_model]\ncore = 1\n", 1)
-                            if "[beam_model]\n" in text else text + "\n[beam_model]\ncore = 1\n")
+            path.write_text(text + "\n[beam_model]\ncore = 1\n" if table is None
+                            else text.replace("[beam_model]\n", "[beam_model]\ncore = 1\n", 1))
         cmd = [str(SANDWICH), "solve", str(path), "--model", model, "--quiet", "--out", tmp]
         if model == "2d":
             cmd += ["--level", "coarse"]

@@ -290,8 +290,12 @@ class _StepSize:
 class _Follower:
     """State machine of :func:`follow_path` (one instance per call)."""
 
-    limit_corrections = False  # contact-limited corrections, on once a corrector has failed
     failed_once = False  # a corrector of this path has failed
+
+    @property
+    def limit_corrections(self) -> bool:
+        """Contact-limited corrections: on once a corrector of this path has failed."""
+        return self.failed_once and LIMIT_AFTER_FAILURE
 
     def __init__(
         self,
@@ -667,8 +671,6 @@ class _Follower:
         res = newton_correct(self.system, u, lam, constraint, settings, u_start, lam_start)
         if not res.converged:
             self.failed_once = True
-            if LIMIT_AFTER_FAILURE:
-                self.limit_corrections = True
         return res
 
     def _weighed_iterations(self, trial: _Trial) -> int:
