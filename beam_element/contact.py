@@ -451,6 +451,20 @@ def _closest_point_kernel():
     return _KERNEL[0]
 
 
+def _penalty_kernel():
+    """The compiled penalty blocks (:mod:`beam_element.contact_kernel`), or None without numba."""
+    if not _PENALTY:
+        try:
+            from beam_element.contact_kernel import penalty_blocks
+        except ImportError:
+            penalty_blocks = None
+        _PENALTY.append(penalty_blocks)
+    return _PENALTY[0]
+
+
+_PENALTY: list = []
+
+
 def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:
     """Closest-point kinematics of every pair: compiled where numba is, else NumPy."""
     kernel = _closest_point_kernel()
@@ -582,10 +596,7 @@ def pressure_law(
     ``penalty`` is ε (N/mm³), ``smoothing`` the width s (mm) of the regularisation (see the
     module docstring); s = 0 is the plain penalty ε ⟨−g⟩.
     """
-    if not (np.isfinite(penalty) and penalty > 0):
-        raise ValueError(f"contact penalty must be positive, got {penalty!r}")
-    if not (np.isfinite(smoothing) and smoothing >= 0):
-        raise ValueError(f"contact smoothing must be >= 0 mm, got {smoothing!r}")
+    _check_law(penalty, smoothing)
     g = np.asarray(gap, dtype=float)
     if smoothing == 0:
         return penalty * np.maximum(-g, 0.0), np.where(g < 0, -penalty, 0.0)
@@ -594,6 +605,13 @@ def pressure_law(
     p = penalty * smoothing * (_softplus(x) - _softplus(-SHIFT))
     dp = -penalty * 0.5 * (1.0 + np.tanh(0.5 * x))  # −ε / (1 + e⁻ˣ)
     return np.where(closed, p, 0.0), np.where(closed, dp, 0.0)
+
+
+def _check_law(penalty: float, smoothing: float) -> None:
+    if not (np.isfinite(penalty) and penalty > 0):
+        raise ValueError(f"contact penalty must be positive, got {penalty!r}")
+    if not (np.isfinite(smoothing) and smoothing >= 0):
+        raise ValueError(f"contact smoothing must be >= 0 mm, got {smoothing!r}")
 
 
 def _softplus(x: np.ndarray | float) -> np.ndarray:
@@ -649,7 +667,27 @@ def _penalty_blocks(
     gap: np.ndarray, grad: np.ndarray, hess: np.ndarray, area: np.ndarray, penalty: float,
     smoothing: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Force −p A ∂g, tangent −A p'(g) ∂g ∂gᵀ − p A ∂²g and pressure p of each pair."""
+    """Force −p A ∂g, tangent −A p'(g) ∂g ∂gᵀ − p A ∂²g and pressure p of each pair.
+
+    Compiled (:func:`beam_element.contact_kernel.penalty_blocks`, the same law per pair) where
+    numba is, else in NumPy from :func:`pressure_law`.
+    """
+    kernel = _penalty_kernel()
+    if kernel is not None and gap.size:
+        _check_law(penalty, smoothing)
+        return kernel(np.ascontiguousarray(gap, dtype=float),
+                      np.ascontiguousarray(grad, dtype=float),
+                      np.ascontiguousarray(hess, dtype=float),
+                      np.ascontiguousarray(area, dtype=float), float(penalty), float(smoothing),
+                      SHIFT)
+    return _penalty_blocks_numpy(gap, grad, hess, area, penalty, smoothing)
+
+
+def _penalty_blocks_numpy(
+    gap: np.ndarray, grad: np.ndarray, hess: np.ndarray, area: np.ndarray, penalty: float,
+    smoothing: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_penalty_blocks` in NumPy (the reference the compiled one is tested against)."""
     p, dp = pressure_law(gap, penalty, smoothing)  # eq. (41): contact pressure, MPa
     f = -(p * area)[:, None] * grad
     K = (-dp * area)[:, None, None] * grad[:, :, None] * grad[:, None, :]

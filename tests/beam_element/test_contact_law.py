@@ -69,3 +69,32 @@ def test_contact_tangent_matches_finite_differences_in_the_smooth_band():
             fm = penalty_response(pairs, u - du, EPS, S)[0][m]
             fd = (fp - fm) / (2 * step)
             assert np.allclose(K[m][:, j], fd, rtol=1e-5, atol=1e-6 * np.abs(K[m]).max())
+
+
+def test_compiled_penalty_blocks_are_the_numpy_law_to_round_off():
+    """The compiled blocks (contact_kernel.penalty_blocks) against the NumPy reference
+    (pressure_law, then the outer products): open, in the softplus knee, deep, and the plain
+    penalty (s = 0); relative round-off of each block's largest entry."""
+    from beam_element import contact
+
+    kernel = contact._penalty_kernel()
+    if kernel is None:
+        import pytest
+
+        pytest.skip("numba is not installed: the NumPy blocks are the only ones")
+    rng = np.random.default_rng(3)
+    gap = -S * np.array([-2.0, 0.0, 0.5, 20.0, 25.0, 30.0, 400.0, 1e5])
+    m, n = gap.size, 10
+    grad = rng.normal(size=(m, n))
+    hess = rng.normal(size=(m, n, n))
+    hess = hess + hess.transpose(0, 2, 1)
+    area = rng.uniform(1.0, 3.0, m)
+    for smoothing in (S, 0.0):
+        f, K, p = contact._penalty_blocks(gap, grad, hess, area, EPS, smoothing)
+        f0, K0, p0 = contact._penalty_blocks_numpy(gap, grad, hess, area, EPS, smoothing)
+        assert np.all(p[:2] == 0) and np.all(f[:2] == 0) and np.all(K[:2] == 0)  # open
+        scale = np.abs(K0).max(axis=(1, 2))[:, None, None] + 1e-300
+        assert np.allclose(p, p0, rtol=1e-13, atol=0)
+        assert np.all(np.abs(K - K0) <= 1e-13 * scale)
+        assert np.all(np.abs(f - f0) <= 1e-13 * (np.abs(f0).max(axis=1)[:, None] + 1e-300))
+        assert np.any(p0 > 0)
