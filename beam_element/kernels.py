@@ -54,8 +54,9 @@ from beam_element.layer_operators import LayerOperators
 from beam_element.sum_factor import factored_flops, factored_kernel, factored_operators
 from sandwich.solver.jit import njit
 
-__all__ = ["KernelOperators", "block_pattern", "block_slots", "embed_pattern", "kernel_operators",
-           "layer_assemble", "layer_blocks", "layer_flops", "layer_response", "point_flops",
+__all__ = ["KernelOperators", "add_reduced", "block_pattern", "block_slots", "embed_pattern",
+           "kernel_operators", "layer_assemble", "layer_blocks", "layer_flops", "layer_response",
+           "point_flops",
            "scatter_blocks", "scatter_compact", "scatter_compact_known", "supports",
            "uses_sum_factorisation"]
 
@@ -427,6 +428,22 @@ def embed_pattern(indptr, indices, k_indptr, k_indices, k_data, out):  # pragma:
                 return False
             out[p] += k_data[t]
     return True
+
+
+@njit
+def add_reduced(dofs, f, free, sign, out):  # pragma: no cover - compiled
+    """``out += Tᵀ`` (the local forces ``f`` (B, n) on full DOFs ``dofs`` (B, n)).
+
+    :func:`beam_element.assembly.scatter_vector` and :meth:`DofMap.reduce
+    <beam_element.constraints.DofMap.reduce>` in one pass, without the full vector: a full
+    DOF d goes to free row ``free[d]`` (if ≥ 0) with ``sign[d]``.
+    """
+    for e in range(dofs.shape[0]):
+        for a in range(dofs.shape[1]):
+            d = dofs[e, a]
+            r = free[d]
+            if r >= 0:
+                out[r] += sign[d] * f[e, a]
 
 
 @njit

@@ -406,8 +406,11 @@ class BeamModel:
         """
         if self._cache is not None and np.array_equal(self._cache[0], u):
             return self._cache[1]
-        f_full, _ = self.full_response(self.expand(u), tangent=False)
-        return self.dof_map.reduce(f_full)
+        kernels = _kernels() if self.use_kernels else None
+        if kernels is None:
+            return self.dof_map.reduce(self.full_response(self.expand(u), tangent=False)[0])
+        rows, forces, _ = self._local_responses(kernels, self.expand(u), False, True, None)
+        return self._reduced_force(kernels, rows, forces)
 
     def internal_force_nearby(self, u: np.ndarray) -> np.ndarray:
         """f_int(u) for an iterate within a converged increment of the last evaluated one.
@@ -428,8 +431,7 @@ class BeamModel:
         if (kernels is None or not isinstance(last, _Assembled) or last.terms is None
                 or last.terms[0] is not self.pattern or np.array_equal(cache[0], u)):
             return self._evaluate(u, tangent=False)[0]
-        f_full, assembled = self._compiled_forces(self.expand(u), kernels, nearby=last)
-        f = self.dof_map.reduce(f_full)
+        f, assembled = self._compiled_forces(self.expand(u), kernels, nearby=last)
         self._cache = (np.array(u, dtype=float, copy=True), f, assembled.K, assembled)
         return f
 
@@ -443,11 +445,13 @@ class BeamModel:
             self._cache = (cache[0], cache[1], K, cache[3])
             return cache[1], K
         u_full = self.expand(u)
-        f_full, states = self._forces(u_full)
-        f = self.dof_map.reduce(f_full)
-        if isinstance(states, _Assembled):  # compiled path: the tangent came with the force
+        kernels = _kernels() if self.use_kernels else None
+        if kernels is not None:  # the tangent comes with the force
+            f, states = self._compiled_forces(u_full, kernels)
             K = states.K
         else:
+            f_full, states = self._forces(u_full)
+            f = self.dof_map.reduce(f_full)
             K = (self.full_pattern.assemble(self._tangent_blocks(u_full, states)) if tangent
                  else None)
         self._cache = (np.array(u, dtype=float, copy=True), f, K, states)
@@ -462,19 +466,14 @@ class BeamModel:
                  self.block_dofs[len(self.core) + 1])]
         return out
 
-    def _forces(
-        self, u_full: np.ndarray, compiled: bool | None = None
-    ) -> tuple[np.ndarray, list[list[LayerState]] | _Assembled]:
-        """Internal force on the full DOFs and the layer states (per family, chunk).
+    def _forces(self, u_full: np.ndarray) -> tuple[np.ndarray, list[list[LayerState]]]:
+        """Internal force on the full DOFs and the layer states (per family, chunk): NumPy.
 
-        With the compiled kernels (:mod:`beam_element.kernels`; ``compiled`` defaults to
-        :attr:`use_kernels` and numba being importable) the reduced tangent is assembled in the
-        same pass and returned instead of the states: a Newton iteration asks for the tangent
-        at every u whose residual it evaluates (fig. 5: 139 forces, 140 tangents).
+        The reference path (:mod:`beam_element.element`). With the compiled kernels the model
+        takes :meth:`_compiled_forces` instead, which assembles the reduced tangent in the same
+        pass: a Newton iteration asks for the tangent at every u whose residual it evaluates
+        (fig. 5: 139 forces, 140 tangents).
         """
-        kernels = _kernels() if (self.use_kernels if compiled is None else compiled) else None
-        if kernels is not None:
-            return self._compiled_forces(u_full, kernels)
         forces, states = [], []
         lengths = self.mesh.lengths
         for op, _, els, dofs in self._families():
@@ -492,10 +491,12 @@ class BeamModel:
     def _compiled_forces(
         self, u_full: np.ndarray, kernels: object, nearby: _Assembled | None = None
     ) -> tuple[np.ndarray, _Assembled]:
-        """Force and reduced tangent in one pass: layers by the kernels, contact compact.
+        """Force on the free DOFs and reduced tangent in one pass (layers by the kernels).
 
-        A closest-point pair whose chosen segment the pattern lacks grows it
-        (:meth:`_grow_pattern`) and the pass is made again on the grown pattern (in full).
+        Contact compact; each family's force is added into the free DOFs by
+        :func:`beam_element.kernels.add_reduced`. A closest-point pair whose chosen segment
+        the pattern lacks grows it (:meth:`_grow_pattern`) and the pass is made again on the
+        grown pattern (in full).
         With ``nearby`` (the last evaluation, :meth:`internal_force_nearby`) the layers give
         their force only and the tangent is ``nearby``'s values with its contact terms
         replaced by this u's; ``nearby`` is spent (its matrix is this one).
@@ -562,7 +563,7 @@ class BeamModel:
         n = self.pattern.n
         K = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=(n, n))
         assembled = _Assembled(K, contact, (pattern, terms))
-        return scatter_vector(u_full.size, force_dofs, forces), assembled
+        return self._reduced_force(kernels, force_dofs, forces), assembled
 
     def _scatter_compact(self, kernels: object, group: int, free: np.ndarray, sign: np.ndarray,
                          K: np.ndarray, pattern: ReducedPattern, data: np.ndarray) -> int:
@@ -622,8 +623,17 @@ class BeamModel:
             if kernels is None:  # the NumPy path evaluates every element
                 return self.full_response(u_full, tangent=False)
         if kernels is None:
-            f_full, states = self._forces(u_full, compiled=False)
+            f_full, states = self._forces(u_full)
             return f_full, (self._tangent_blocks(u_full, states) if tangent else [])
+        rows, forces, blocks = self._local_responses(kernels, u_full, tangent, contact_blocks,
+                                                     elements)
+        return scatter_vector(u_full.size, rows, forces), (blocks if tangent else [])
+
+    def _local_responses(
+        self, kernels: object, u_full: np.ndarray, tangent: bool, contact_blocks: bool,
+        elements: np.ndarray | None,
+    ) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
+        """:meth:`full_response`'s local forces with their full DOFs, and its blocks."""
         forces, blocks, rows = [], [], []
         lengths = self.mesh.lengths
         for op, products, els, dofs in self._families():
@@ -655,7 +665,20 @@ class BeamModel:
             if contact_blocks:
                 blocks.append(K)
         rows += [pairs.block_dofs for pairs in self.pairs]
-        return scatter_vector(u_full.size, rows, forces), (blocks if tangent else [])
+        return rows, forces, blocks
+
+    def _reduced_force(self, kernels: object, rows: list[np.ndarray],
+                       forces: list[np.ndarray]) -> np.ndarray:
+        """Σ of the local ``forces`` on full DOFs ``rows``, on the free DOFs (Tᵀ f).
+
+        Family by family in one order, so that every compiled evaluation of a force sums its
+        terms alike (:meth:`internal_force_only` equals :meth:`internal_force` bit for bit).
+        """
+        f = np.zeros(self.size)
+        dm = self.dof_map
+        for dofs, fe in zip(rows, forces, strict=True):
+            kernels.add_reduced(dofs, np.ascontiguousarray(fe, dtype=float), dm.free, dm.sign, f)
+        return f
 
     def contact_summary(self, u: np.ndarray) -> dict[str, ContactSummary]:
         """Penetration, pressure and sliding per interface at free DOFs ``u``."""
