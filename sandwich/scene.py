@@ -195,7 +195,7 @@ class BeamModelOptions:
     tolerance: float = 0.01  # "auto": target relative error of the core's through-thickness field
     max_core_level: int = 3  # "auto": highest level it may choose (docs/beam_element.md)
     core_zones: tuple[CoreZone, ...] = ()  # explicit levels over stretches of x
-    settling_allowance: int | None = None  # step sizes (docs/solver.md "Settling iterations")
+    settling_allowance: int | None = 2  # step sizes (docs/solver.md "Settling iterations")
 
 
 @dataclass(frozen=True)

@@ -529,8 +529,8 @@ def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
         gauss_z=r.integer(t, "gauss_z", key, default=None, lo=2, hi=12),
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
         profile_every=r.integer(t, "profile_every", key, default=0, lo=0) or 0,
-        settling_allowance=r.integer(t, "settling_allowance", key, default=None, lo=0,
-                                     hi=1000),
+        settling_allowance=r.integer(t, "settling_allowance", key,
+                                     default=d.settling_allowance, lo=0, hi=1000),
     )
 
 

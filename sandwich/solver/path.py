@@ -86,6 +86,11 @@ LIMIT_AFTER_FAILURE = True
 #: last step across a critical point").
 CRITICAL_TARGET_CUTS = 2
 CRITICAL_TARGET = "a hard step across a critical point and the target"  # that cut's reason
+BENT = "the load curve bends within a step the settling allowance grew"  # that cut's reason
+#: The settling allowance (``PathOptions.settling_allowance``) weighs a step only where the
+#: path's last two steps turn by less than this angle (radians) in the plane of its load curve
+#: (:meth:`_Follower._straight`; docs/solver.md, "Settling iterations").
+SETTLING_BEND = math.radians(2.0)
 
 
 @dataclass
@@ -260,6 +265,7 @@ class _StepSize:
     h_min: float
     h_max: float
     desired_iterations: int
+    by_allowance: bool = False  # h was grown by the settling allowance's weighing
 
     @classmethod
     def start(cls, opt: PathOptions, h_auto: Callable[[], float]) -> _StepSize:
@@ -291,6 +297,9 @@ class _Follower:
     """State machine of :func:`follow_path` (one instance per call)."""
 
     failed_once = False  # a corrector of this path has failed
+    curve_probe: tuple[str | None, float] = (None, 0.0)  # set once the linear solution is known
+    states: list[PathState]
+    lam_est = 1.0
 
     @property
     def limit_corrections(self) -> bool:
@@ -386,6 +395,7 @@ class _Follower:
             return self.finish(False, "step 1: f_ref is zero or the linear solution is not finite")
         self.psi = opt.arc_load_weight * tn
         self.lam_est = self._target_load_estimate(t)
+        self.curve_probe = self._curve_probe(t)
         size = _StepSize.start(opt, lambda: self._auto_increment(t))
         self.prev_step: tuple[np.ndarray, float] | None = None
         self.recent: list[tuple[float, float]] = []  # (increment, until-probe change) accepted
@@ -427,7 +437,9 @@ class _Follower:
                 return self.finish(True, done)
             if crossed:
                 return self._finish_crossed(crossed)
-            size.after(h_try, self._weighed_iterations(trial), cuts)
+            weighed = self._weighed_iterations(trial)
+            size.after(h_try, weighed, cuts)
+            size.by_allowance = weighed < trial.iterations and not cuts  # grown by it
         s = self.states[-1]
         return self.finish(False, (
             f"max_steps = {opt.max_steps} reached at λ = {s.load_factor:.6g} "
@@ -454,6 +466,9 @@ class _Follower:
                 self.sigma = sign
             limit = self.limit_corrections and not limited_failed
             trial, reason = self._attempt(h_try, last, t, rises, limit)
+            if (trial is not None and size.by_allowance and cuts == 0 and not direct
+                    and self._bends_within(last, trial, t)):
+                trial, reason = None, BENT
             if trial is not None and cuts < CRITICAL_TARGET_CUTS and 0.5 * h_try >= size.h_min \
                     and self._hard_across_target(last, trial):
                 trial, reason = None, CRITICAL_TARGET
@@ -537,6 +552,18 @@ class _Follower:
             if ct != 0.0:
                 ests.append(self.opt.until_value / ct)
         return min(ests, key=abs) if ests else 1.0
+
+    def _curve_probe(self, t: np.ndarray) -> tuple[str | None, float]:
+        """The load curve's probe and its linear value at the target's estimated load.
+
+        The until probe, else the first probe asked for; (None, 0) without a probe or where
+        that value is 0.
+        """
+        names = [n for n in (self.opt.until_probe,) if n] or list(self.c)
+        if not names:
+            return None, 0.0
+        scale = abs(self.dot(self.c[names[0]], t) * self.lam_est)
+        return (names[0], scale) if scale > 0.0 and math.isfinite(scale) else (None, 0.0)
 
     def _auto_increment(self, t: np.ndarray) -> float:
         """1/20 of the (linearly estimated) distance to the target, in control units."""
@@ -676,16 +703,62 @@ class _Follower:
     def _weighed_iterations(self, trial: _Trial) -> int:
         """The iterations the step-size controller weighs a converged step by.
 
-        All of them, unless :attr:`PathOptions.settling_allowance` is set and no corrector of
-        this path has failed: then at most the iterations until the increment test first
-        passed plus that allowance (the others settle a residual while the state no longer
-        moves — the beam's contact pairs in the penalty law's knee — and do not shrink with
-        the step).
+        All of them, unless :attr:`PathOptions.settling_allowance` is set, no corrector of
+        this path has failed and the load curve's last two steps turn by less than
+        :data:`SETTLING_BEND` (:meth:`_straight`): then at most the iterations until the
+        increment test first passed plus that allowance (the others settle a residual while
+        the state no longer moves — the beam's contact pairs in the penalty law's knee — and
+        do not shrink with the step). A step so grown is checked for a bend within it
+        (:meth:`_bends_within`).
         """
         k = self.opt.settling_allowance
         if k is None or self.failed_once or trial.increment_iterations is None:
             return trial.iterations
+        if not self._straight():
+            return trial.iterations
         return min(trial.iterations, trial.increment_iterations + k)
+
+    def _bends_within(self, last: PathState, trial: _Trial, t: np.ndarray) -> bool:
+        """Whether a step's secant turns from its predictor by more than SETTLING_BEND.
+
+        In the load curve's plane (:meth:`_straight`), the predictor along the tangent
+        K⁻¹ f_ref at ``last``, either sense: a knee the step has crossed (the debonded face's
+        buckling, a crushing) that the steps before it could not announce.
+        """
+        name, scale = self.curve_probe
+        if name is None:
+            return False
+        lam_scale = abs(self.lam_est) or 1.0
+        p = (self.dot(self.c[name], t) / scale, 1.0 / lam_scale)
+        d = ((self._value(name, trial.u, 0.0) - last.probes[name]) / scale,
+             (trial.load_factor - last.load_factor) / lam_scale)
+        n1, n2 = math.hypot(*p), math.hypot(*d)
+        if n1 == 0.0 or n2 == 0.0 or not math.isfinite(n1):
+            return False
+        return bool(abs(p[0] * d[0] + p[1] * d[1]) / (n1 * n2) < math.cos(SETTLING_BEND))
+
+    def _straight(self) -> bool:
+        """Whether the path's last two steps turn by less than :data:`SETTLING_BEND`.
+
+        Measured in the plane of the load curve a user plots: (probe / its linear value at the
+        target's load, λ / the target's load), the probe being the until probe, else the first
+        probe asked for (:attr:`curve_probe`). False with fewer than two steps, without a
+        probe, or where the probe's linear value is zero.
+        """
+        name, scale = self.curve_probe
+        if name is None or len(self.states) < 3:
+            return False
+        lam_scale = abs(self.lam_est) or 1.0
+        a, b, c = self.states[-3:]
+        d1 = ((b.probes[name] - a.probes[name]) / scale,
+              (b.load_factor - a.load_factor) / lam_scale)
+        d2 = ((c.probes[name] - b.probes[name]) / scale,
+              (c.load_factor - b.load_factor) / lam_scale)
+        n1, n2 = math.hypot(*d1), math.hypot(*d2)
+        if n1 == 0.0 or n2 == 0.0:
+            return False
+        cos = (d1[0] * d2[0] + d1[1] * d2[1]) / (n1 * n2)
+        return cos >= math.cos(SETTLING_BEND)
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).

@@ -3,28 +3,44 @@
 A corrector whose increment has converged may keep iterating to settle its residual (the beam's
 contact pairs in the penalty law's knee) without moving the state; with an allowance k the
 controller weighs such a step by the iterations its increment test took plus k, until the
-path's first failed corrector. Checked: the rule itself (a follower's ``_weighed_iterations``),
-the option's validation, that it is off by default, and on the beam (fig. 9 d10, the paper's
-core, 60 elements) that the path takes fewer steps and ends at the same equilibrium as with the
-plain controller (the reference: the same scene with the key off).
+path's first failed corrector and only where the load curve's last two steps turn by less than
+``SETTLING_BEND``; a step so grown whose secant turns from its predictor by more is cut.
+Checked: the rule itself (a follower's ``_weighed_iterations``) and both angles (closed-form
+angles of synthetic states), the option's validation, that it is on (k = 2) for the beam by
+default and not an ``[analysis]`` option, and on the beam (fig. 9 d10, the paper's core, 60
+elements) that the path takes fewer steps and ends at the same equilibrium as with the plain
+controller (the reference: the same scene with the allowance off).
 """
 
 import dataclasses
+import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sandwich.scene_file import load_scene
 from sandwich.solver import PathOptions
-from sandwich.solver.path import _Follower, _Trial
+from sandwich.solver.path import SETTLING_BEND, PathState, _Follower, _Trial
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
 
-def _follower(allowance, failed=False):
-    f = _Follower.__new__(_Follower)  # the rule reads only the options and the failure flag
-    f.opt = PathOptions(settling_allowance=allowance, until_load_factor=1.0)
+def _state(w, lam):
+    return PathState(0, None, lam, 0, {"w": w}, None, 0)
+
+
+def _follower(allowance, failed=False, turn=0.0):
+    """A follower whose last two steps (of the load curve w ↦ λ, both scaled to 1 at the
+    target) turn by ``turn`` radians; the rule reads only these, the options and the flag."""
+    f = _Follower.__new__(_Follower)
+    f.opt = PathOptions(settling_allowance=allowance, until_probe="w", until_value=-2.0)
     f.failed_once = failed
+    f.lam_est, f.curve_probe = 10.0, ("w", 2.0)
+    a = math.radians(30.0)  # the first step's direction in the scaled plane
+    f.states = [_state(0.0, 0.0), _state(-0.2 * math.cos(a), 1.0 * math.sin(a))]
+    f.states.append(_state(f.states[1].probes["w"] - 0.2 * math.cos(a + turn),
+                           f.states[1].load_factor + 1.0 * math.sin(a + turn)))
     return f
 
 
@@ -44,14 +60,46 @@ def test_without_the_allowance_or_after_a_failed_corrector_every_iteration_count
     assert _follower(2)._weighed_iterations(_trial(8, None)) == 8
 
 
+def test_where_the_load_curve_bends_every_iteration_counts():
+    """The angle between the last two steps in the scaled (w, λ) plane, either way round."""
+    for turn, allowed in ((0.0, True), (0.9 * SETTLING_BEND, True), (-0.9 * SETTLING_BEND, True),
+                          (1.1 * SETTLING_BEND, False), (-1.1 * SETTLING_BEND, False),
+                          (math.pi / 2, False)):
+        assert _follower(2, turn=turn)._weighed_iterations(_trial(8, 1)) == (3 if allowed else 8)
+    f = _follower(2)
+    f.states = f.states[:2]  # one step: no bend known yet
+    assert f._weighed_iterations(_trial(8, 1)) == 8
+    f = _follower(2)
+    f.curve_probe = (None, 0.0)  # no probe to draw the curve with
+    assert f._weighed_iterations(_trial(8, 1)) == 8
+
+
+
+def test_a_grown_step_is_cut_where_its_secant_turns_from_its_predictor():
+    """Predictor along the tangent (dw/dλ = −0.04, i.e. 45° in the scaled plane: w / 2, λ / 10);
+    the converged step's secant turned by ±0.9 or ±1.1 × SETTLING_BEND, or reversed."""
+    f = _follower(2)
+    f.c, f.dot = {"w": np.ones(1)}, np.dot
+    t = np.array([-0.2])  # scaled (c·t / 2, 1 / 10) = (−0.1, 0.1): the direction 135°
+    last = _state(0.0, 0.0)
+    for turn, bent in ((0.0, False), (0.9, False), (-0.9, False), (1.1, True), (-1.1, True)):
+        a = math.radians(135.0) + turn * SETTLING_BEND  # the predictor's direction, turned
+        trial = _Trial(np.array([2.0 * 0.1 * math.cos(a)]), 10.0 * 0.1 * math.sin(a), 3, None)
+        assert f._bends_within(last, trial, t) is bent, turn
+    back = _Trial(np.array([0.1]), -0.5, 3, None)  # straight back along the tangent: no bend
+    assert f._bends_within(last, back, t) is False
+    f.curve_probe = (None, 0.0)
+    assert f._bends_within(last, _Trial(np.array([1.0]), 0.0, 3, None), t) is False
+
+
 def test_a_negative_allowance_is_refused():
     with pytest.raises(ValueError, match="settling_allowance"):
         PathOptions(settling_allowance=-1, until_load_factor=1.0)
 
 
-def test_the_scene_key_is_off_by_default_and_not_an_analysis_option():
+def test_the_scene_key_is_two_by_default_and_not_an_analysis_option():
     scene = load_scene(SCENES / "paper-fig5-top-debond-40-load-top.toml")
-    assert scene.beam_model.settling_allowance is None
+    assert scene.beam_model.settling_allowance == 2
     assert PathOptions.from_analysis(scene.analysis).settling_allowance is None
 
 
