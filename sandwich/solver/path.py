@@ -35,9 +35,11 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
 - on failure the increment is halved (``cuts``) down to ``min_increment``, then the path stops;
   on success it grows or shrinks by ``√(desired_iterations / iterations)`` within [½, 2]
   (it never grows after a cut step) and is clipped to [min_increment, max_increment]. With
-  ``settling_allowance`` k (off unless a model sets it), ``iterations`` is at most the
-  corrector's iterations until its increment test first passed plus k, as long as no
-  corrector of the path has failed (docs/solver.md, "Settling iterations").
+  ``settling_allowance`` k (off unless a model sets it; the beam sets 2), ``iterations`` is at
+  most the corrector's iterations until its increment test first passed plus k, as long as no
+  corrector of the path has failed and the load curve's last two steps turn by less than
+  ``SETTLING_BEND``; a step so grown whose secant turns from its predictor by more is cut
+  (docs/solver.md, "Settling iterations").
 
 ψ (:attr:`PathOptions.arc_load_weight` × ``‖K(0)⁻¹ f_ref‖``) converts λ into displacement units,
 so in the linear range the λ and u parts of the arc weigh the same.
@@ -120,9 +122,10 @@ class PathOptions:
         Iteration count for which the increment is kept; fewer grow it, more shrink it.
     settling_allowance
         ``None`` (default): the controller weighs a step by all its corrector's iterations.
-        A number k (the beam's ``[beam_model] settling_allowance``): until the path's first
-        failed corrector, by at most the iterations its increment test took to pass plus k
-        (module docstring, step size; docs/solver.md "Settling iterations").
+        A number k (the beam's ``[beam_model] settling_allowance``, 2 by default): until the
+        path's first failed corrector and where the load curve is straight, by at most the
+        iterations its increment test took to pass plus k (module docstring, step size;
+        docs/solver.md "Settling iterations").
     control_probe
         Probe driven under displacement control (default: :attr:`until_probe`).
     arc_load_weight

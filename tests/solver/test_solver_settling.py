@@ -116,3 +116,16 @@ def test_the_beam_path_takes_fewer_steps_to_the_same_end_state():
     assert plain.converged and settled.converged
     assert len(settled.history) < 0.8 * len(plain.history)
     assert settled.final_load_factor == pytest.approx(plain.final_load_factor, rel=1e-8)
+
+
+def test_an_allowance_of_max_iterations_is_the_controller_without_it():
+    """docs/scenes.md: a value at or above [analysis] max_iterations turns it off — the same
+    states as without the allowance (fig. 9 d10, the paper's core, 60 elements)."""
+    from beam_element import run
+    scene = load_scene(SCENES / "paper-fig9-clamped-d10.toml")
+    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, core=1, core_zones=(), elements=60, settling_allowance=None))
+    plain = run(scene).solution
+    off = run(dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, settling_allowance=scene.analysis.max_iterations))).solution
+    assert [s.load_factor for s in off.history] == [s.load_factor for s in plain.history]
