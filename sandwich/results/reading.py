@@ -122,7 +122,9 @@ def load_result(folder: str | Path, *, fields: bool = True) -> Solution:
     summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
     limit_points = [
         LimitPoint(kind=lp["kind"], step=int(lp["step"]), load_factor=_float(lp["load_factor"]),
-                   probes={k: _float(v) for k, v in lp.get("probes", {}).items()})
+                   probes={k: _float(v) for k, v in lp.get("probes", {}).items()},
+                   between=(tuple(_float(v) for v in lp["between_load_factors"])
+                            if "between_load_factors" in lp else None))
         for lp in summary.get("limit_points", [])
     ]
     return Solution(

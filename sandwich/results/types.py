@@ -45,6 +45,10 @@ class LimitPoint:
     step: int
     load_factor: float
     probes: dict[str, float]
+    # load factors of the converged states that enclose the point along the path: a
+    # bifurcation lies between the state before ``step`` and ``step``, an extremum between the
+    # states either side of ``step``; the point is known to that resolution only
+    between: tuple[float, float] | None = None
 
 
 @dataclass

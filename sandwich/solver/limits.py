@@ -7,6 +7,10 @@
   that is not explained by a limit point: a simple limit point changes the count by one between
   the state before and the state after it; any further change (or a change with no limit point
   next to it) is reported at the first state with the new count.
+
+Each point carries ``between``: the load factors of the two converged states that enclose it
+along the path (the states either side of an extremum; the state before a bifurcation and the
+one reported), so a user sees to what resolution the path located it.
 """
 
 from __future__ import annotations
@@ -43,7 +47,9 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
             k = int(j0) + 1  # the extreme state ends the first increment
             kind = "max" if dlam[j0] > 0 else "min"
             s = states[k]
-            found.append(LimitPoint(kind, s.step, float(s.load_factor), dict(s.probes)))
+            after = int(j1) + 1  # the state that ends the next non-zero increment
+            found.append(LimitPoint(kind, s.step, float(s.load_factor), dict(s.probes),
+                                    (float(lam[int(j0)]), float(lam[after]))))
             limit_at.add(k)
     used: set[int] = set()
     for k in range(1, n):
@@ -57,6 +63,7 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
                 change -= 1
         if change:
             s = states[k]
-            found.append(LimitPoint("bifurcation", s.step, float(s.load_factor), dict(s.probes)))
+            found.append(LimitPoint("bifurcation", s.step, float(s.load_factor), dict(s.probes),
+                                    (float(lam[k - 1]), float(lam[k]))))
     found.sort(key=lambda lp: lp.step)
     return found
