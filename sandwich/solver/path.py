@@ -251,6 +251,14 @@ class _Trial:
     increment_iterations: int | None = None  # until its increment test first passed
 
 
+def _cosine(a: tuple[float, float], b: tuple[float, float]) -> float | None:
+    """The cosine of the angle between two plane vectors; None if either is zero or not finite."""
+    na, nb = math.hypot(*a), math.hypot(*b)
+    if not (0.0 < na < math.inf and 0.0 < nb < math.inf):
+        return None
+    return float((a[0] * b[0] + a[1] * b[1]) / (na * nb))
+
+
 def _fmt_probes(probes: dict[str, float]) -> str:
     return ", ".join(f"{k} = {v:.6g}" for k, v in probes.items())
 
@@ -735,10 +743,8 @@ class _Follower:
         p = (self.dot(self.c[name], t) / scale, 1.0 / lam_scale)
         d = ((self._value(name, trial.u, 0.0) - last.probes[name]) / scale,
              (trial.load_factor - last.load_factor) / lam_scale)
-        n1, n2 = math.hypot(*p), math.hypot(*d)
-        if n1 == 0.0 or n2 == 0.0 or not math.isfinite(n1):
-            return False
-        return bool(abs(p[0] * d[0] + p[1] * d[1]) / (n1 * n2) < math.cos(SETTLING_BEND))
+        cos = _cosine(p, d)
+        return cos is not None and abs(cos) < math.cos(SETTLING_BEND)
 
     def _straight(self) -> bool:
         """Whether the path's last two steps turn by less than :data:`SETTLING_BEND`.
@@ -757,11 +763,8 @@ class _Follower:
               (b.load_factor - a.load_factor) / lam_scale)
         d2 = ((c.probes[name] - b.probes[name]) / scale,
               (c.load_factor - b.load_factor) / lam_scale)
-        n1, n2 = math.hypot(*d1), math.hypot(*d2)
-        if n1 == 0.0 or n2 == 0.0:
-            return False
-        cos = (d1[0] * d2[0] + d1[1] * d2[1]) / (n1 * n2)
-        return cos >= math.cos(SETTLING_BEND)
+        cos = _cosine(d1, d2)
+        return cos is not None and cos >= math.cos(SETTLING_BEND)
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
