@@ -19,7 +19,11 @@ with the four terms t of each field pair: for uu (k, l ∈ N,η N,ξ) t = 00, 11
 ww likewise with H22, H33, H23; uw (k ∈ N, l ∈ M) t = 02, 03, 12, 13, (A, B) = (Zu, Zw),
 (Zu, Zw'), (Zu', Zw), (Zu', Zw'), P = X'X', X'X, XX', XX. The gradients and the force factor
 the same way (ξ-contraction against Z, Z', then η-contraction against X, X'). The same points,
-weights and point matrices as the packed kernel: only the order of the summation changes.
+weights and point matrices as the packed kernel: only the order of the summation changes. The
+gradients' and the force's contractions run over a block of elements at once, as GEMMs with
+the element index inside ((function, element) rows, (element, point) columns): per element they
+were loops of n_ξ over a handful of functions, bound by loop overhead (level 2, 240 elements:
+the force 0.96 → 0.44 ms, force + tangent 3.45 → 3.02 ms; level 3 7.5 → 6.7 ms).
 
 The DOF set need not be a full tensor product (the paper's core has no (H̄, H̄_t) DOF): each
 DOF is one (i, j) of the grid of its field's x- and z-functions, the grid's other entries are
@@ -250,52 +254,6 @@ def factored_flops(fo: FactoredOperators, tangent: bool = True) -> int:
 
 
 @njit(reassociate=True)
-def _z_contract(Ut, ZT, V):  # pragma: no cover - compiled
-    """V[r, q] = Σ_j Ũ[r, j] Z_j(ξ_q) (ZT: (n_z, n_ξ))."""
-    V[:] = 0.0
-    for r in range(Ut.shape[0]):
-        for j in range(Ut.shape[1]):
-            c = Ut[r, j]
-            if c != 0.0:
-                for q in range(ZT.shape[1]):
-                    V[r, q] += c * ZT[j, q]
-
-
-@njit(reassociate=True)
-def _x_contract(X, V, D):  # pragma: no cover - compiled
-    """D[p, q] = Σ_r X_r(η_p) V[r, q]."""
-    D[:] = 0.0
-    for p in range(X.shape[0]):
-        for r in range(X.shape[1]):
-            c = X[p, r]
-            for q in range(V.shape[1]):
-                D[p, q] += c * V[r, q]
-
-
-@njit(reassociate=True)
-def _x_integrate(X, Cq, A):  # pragma: no cover - compiled
-    """A[r, q] = Σ_p X_r(η_p) c[p, q]."""
-    A[:] = 0.0
-    for p in range(X.shape[0]):
-        for r in range(X.shape[1]):
-            c = X[p, r]
-            for q in range(Cq.shape[1]):
-                A[r, q] += c * Cq[p, q]
-
-
-@njit(reassociate=True)
-def _z_integrate(A0, A1, ZT, ZdT, ix, jz, cols, scale, f):  # pragma: no cover - compiled
-    """f[cols[a]] = scale · Σ_q (A0[i, q] Z_j(ξ_q) + A1[i, q] Z'_j(ξ_q)), (i, j) of column a."""
-    for a in range(ix.size):
-        r = ix[a]
-        j = jz[a]
-        s = 0.0
-        for q in range(ZT.shape[1]):
-            s += A0[r, q] * ZT[j, q] + A1[r, q] * ZdT[j, q]
-        f[cols[a]] = s * scale[cols[a]]
-
-
-@njit(reassociate=True)
 def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, ZwT, ZdwT, iw, jw,
                     Quu, Puu, Qww, Pww, Quw, Puw, entries, ucols, wcols, x_slope, weight, C,
                     thickness, f_out, want_k, K_out, slots, signs,
@@ -319,25 +277,17 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, Zw
     c20, c21, c22 = C[2, 0], C[2, 1], C[2, 2]
     nzp = (Quu.shape[2], Qww.shape[2], Quw.shape[2])
     nxp = (Puu.shape[0], Pww.shape[0], Puw.shape[0])
-    # work arrays: one element (gradients, force), one block (the tangent)
-    Ut = np.empty((Xu.shape[1], ZuT.shape[0]))
-    Wt = np.empty((Xw.shape[1], ZwT.shape[0]))
-    Vu0 = np.empty((Xu.shape[1], Gz))
-    Vu1 = np.empty((Xu.shape[1], Gz))
-    Vw0 = np.empty((Xw.shape[1], Gz))
-    Vw1 = np.empty((Xw.shape[1], Gz))
-    Du0 = np.empty((Gx, Gz))
-    Du1 = np.empty((Gx, Gz))
-    Dw0 = np.empty((Gx, Gz))
-    Dw1 = np.empty((Gx, Gz))
-    Cu0 = np.empty((Gx, Gz))
-    Cu1 = np.empty((Gx, Gz))
-    Cw0 = np.empty((Gx, Gz))
-    Cw1 = np.empty((Gx, Gz))
-    Au0 = np.empty((Xu.shape[1], Gz))
-    Au1 = np.empty((Xu.shape[1], Gz))
-    Aw0 = np.empty((Xw.shape[1], Gz))
-    Aw1 = np.empty((Xw.shape[1], Gz))
+    # the ξ-functions transposed once (the force's last contraction)
+    ZuN = np.ascontiguousarray(ZuT.T)
+    ZduN = np.ascontiguousarray(ZduT.T)
+    ZwN = np.ascontiguousarray(ZwT.T)
+    ZdwN = np.ascontiguousarray(ZdwT.T)
+    nxu, nzu, nxw, nzw = Xu.shape[1], ZuT.shape[0], Xw.shape[1], ZwT.shape[0]
+    XuT = np.ascontiguousarray(Xu.T)
+    XduT = np.ascontiguousarray(Xdu.T)
+    XwT = np.ascontiguousarray(Xw.T)
+    XdwT = np.ascontiguousarray(Xdw.T)
+    cur = -1  # the element count the block arrays below are sized for
     scale = np.empty(n)
     ch = min(CHUNK, E) if want_k else 1
     Hb = np.zeros((10, Gx * ch, Gz))  # H00 H11 H01 | H22 H33 H23 | H02 H03 H12 H13, (p, e, q)
@@ -354,35 +304,46 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, Zw
     huw = (6, 7, 8, 9)
     for e0 in range(0, E, CHUNK):
         ec = min(CHUNK, E - e0)
+        if ec != cur:  # block arrays, (function, element, point) with the element inside
+            cur = ec
+            Ub = np.empty((nxu * ec, nzu))
+            Wb = np.empty((nxw * ec, nzw))
+            Du0 = np.empty((Gx, ec * Gz))
+            Du1 = np.empty((Gx, ec * Gz))
+            Dw0 = np.empty((Gx, ec * Gz))
+            Dw1 = np.empty((Gx, ec * Gz))
+            Cu0 = np.empty((Gx, ec * Gz))
+            Cu1 = np.empty((Gx, ec * Gz))
+            Cw0 = np.empty((Gx, ec * Gz))
+            Cw1 = np.empty((Gx, ec * Gz))
+        # u_ref = scale ⊙ u_e (l/2 on x-slope DOFs) on the grid of x- and z-functions
+        Ub[:] = 0.0
+        Wb[:] = 0.0
+        for i in range(ec):
+            half = 0.5 * lengths[e0 + i]
+            for a in range(nu):
+                c = ucols[a]
+                Ub[iu[a] * ec + i, ju[a]] = u_l[e0 + i, c] * (half if x_slope[c] else 1.0)
+            for a in range(nw):
+                c = wcols[a]
+                Wb[iw[a] * ec + i, jw[a]] = u_l[e0 + i, c] * (half if x_slope[c] else 1.0)
+        # ξ first: V[(i, e), q] = Σ_j Ũ[(i, e), j] Z_j(ξ_q), then η: D[p, (e, q)] = Σ_i X_i(η_p)
+        # V[i, (e, q)] — one GEMM each for the block's elements
+        np.dot(Xdu, np.dot(Ub, ZuT).reshape(nxu, ec * Gz), Du0)  # N,η u
+        np.dot(Xu, np.dot(Ub, ZduT).reshape(nxu, ec * Gz), Du1)  # N,ξ u
+        np.dot(Xdw, np.dot(Wb, ZwT).reshape(nxw, ec * Gz), Dw0)
+        np.dot(Xw, np.dot(Wb, ZdwT).reshape(nxw, ec * Gz), Dw1)
         for i in range(ec):
             e = e0 + i
-            half = 0.5 * lengths[e]
-            for a in range(n):  # u_ref = scale ⊙ u_e: l/2 on x-slope DOFs
-                scale[a] = half if x_slope[a] else 1.0
-            Ut[:] = 0.0
-            Wt[:] = 0.0
-            for a in range(nu):
-                Ut[iu[a], ju[a]] = u_l[e, ucols[a]] * scale[ucols[a]]
-            for a in range(nw):
-                Wt[iw[a], jw[a]] = u_l[e, wcols[a]] * scale[wcols[a]]
-            # ξ first: V[i, q] = Σ_j Ũ[i, j] Z_j(ξ_q), then η: D[p, q] = Σ_i X_i(η_p) V[i, q]
-            _z_contract(Ut, ZuT, Vu0)
-            _z_contract(Ut, ZduT, Vu1)
-            _z_contract(Wt, ZwT, Vw0)
-            _z_contract(Wt, ZdwT, Vw1)
-            _x_contract(Xdu, Vu0, Du0)  # N,η u
-            _x_contract(Xu, Vu1, Du1)  # N,ξ u
-            _x_contract(Xdw, Vw0, Dw0)
-            _x_contract(Xw, Vw1, Dw1)
             dx = 2.0 / lengths[e]
             dV0 = width * (0.5 * lengths[e]) * (0.5 * thickness)  # b l h / 4, eq. (19)
             for p in range(Gx):
                 row = p * ec + i  # rows of the block's point matrices: (p, e)
                 for q in range(Gz):
-                    ux = dx * Du0[p, q]  # eq. (15)
-                    uz = dz * Du1[p, q]
-                    wx = dx * Dw0[p, q]
-                    wz = dz * Dw1[p, q]
+                    ux = dx * Du0[p, i * Gz + q]  # eq. (15)
+                    uz = dz * Du1[p, i * Gz + q]
+                    wx = dx * Dw0[p, i * Gz + q]
+                    wz = dz * Dw1[p, i * Gz + q]
                     ex = ux + 0.5 * (ux * ux + wx * wx)  # Green-Lagrange, eq. (15)
                     ez = wz + 0.5 * (uz * uz + wz * wz)
                     gm = uz + wx + ux * uz + wx * wz
@@ -391,10 +352,10 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, Zw
                     sb = dV * (c10 * ex + c11 * ez + c12 * gm)
                     st = dV * (c20 * ex + c21 * ez + c22 * gm)
                     # eq. (19): Σ_g dV σ·B = Σ_g c·R, the rows of eq. (17) sorted by R
-                    Cu0[p, q] = dx * (sa * (1 + ux) + st * uz)
-                    Cu1[p, q] = dz * (sb * uz + st * (1 + ux))
-                    Cw0[p, q] = dx * (sa * wx + st * (1 + wz))
-                    Cw1[p, q] = dz * (sb * (1 + wz) + st * wx)
+                    Cu0[p, i * Gz + q] = dx * (sa * (1 + ux) + st * uz)
+                    Cu1[p, i * Gz + q] = dz * (sb * uz + st * (1 + ux))
+                    Cw0[p, i * Gz + q] = dx * (sa * wx + st * (1 + wz))
+                    Cw1[p, i * Gz + q] = dz * (sb * (1 + wz) + st * wx)
                     if not want_k:
                         continue
                     p00 = dx * (1 + ux)  # Φ of strain_coefficients (B = Φ R, eq. 17)
@@ -430,13 +391,20 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, Zw
                     Hb[7, row, q] = dV * (p00 * a03 + p20 * a23)  # H03
                     Hb[8, row, q] = dV * (p11 * a12 + p21 * a22)  # H12
                     Hb[9, row, q] = dV * (p11 * a13 + p21 * a23)  # H13
-            # force: A[i, q] = Σ_p X_i(η_p) c(p, q), then f_(i j) = Σ_q A[i, q] Z_j(ξ_q)
-            _x_integrate(Xdu, Cu0, Au0)
-            _x_integrate(Xu, Cu1, Au1)
-            _x_integrate(Xdw, Cw0, Aw0)
-            _x_integrate(Xw, Cw1, Aw1)
-            _z_integrate(Au0, Au1, ZuT, ZduT, iu, ju, ucols, scale, f_out[e])
-            _z_integrate(Aw0, Aw1, ZwT, ZdwT, iw, jw, wcols, scale, f_out[e])
+        # force: A[i, (e, q)] = Σ_p X_i(η_p) c(p, (e, q)), then
+        # f_(i j)(e) = Σ_q A[(i, e), q] Z_j(ξ_q) + the ξ-derivative's twin — GEMMs again
+        Fu = np.dot(np.dot(XduT, Cu0).reshape(nxu * ec, Gz), ZuN) + \
+            np.dot(np.dot(XuT, Cu1).reshape(nxu * ec, Gz), ZduN)
+        Fw = np.dot(np.dot(XdwT, Cw0).reshape(nxw * ec, Gz), ZwN) + \
+            np.dot(np.dot(XwT, Cw1).reshape(nxw * ec, Gz), ZdwN)
+        for i in range(ec):
+            half = 0.5 * lengths[e0 + i]
+            for a in range(nu):
+                c = ucols[a]
+                f_out[e0 + i, c] = Fu[iu[a] * ec + i, ju[a]] * (half if x_slope[c] else 1.0)
+            for a in range(nw):
+                c = wcols[a]
+                f_out[e0 + i, c] = Fw[iw[a] * ec + i, jw[a]] * (half if x_slope[c] else 1.0)
         if not want_k:
             continue
         m = Gx * ec
