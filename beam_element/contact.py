@@ -105,6 +105,7 @@ disturbs the pressure there (squeeze test, 10 mm from the tip: +0.56 % at s = 1e
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -437,32 +438,24 @@ def _projection_residual(ξ, l, xa, U, W, xs, ws):
     return r1 * a + r2 * c, -(a**2 + c**2) + r1 * aξ + r2 * cξ, a, c
 
 
-_KERNEL: list = []
+@functools.cache
+def _contact_kernel(name: str):
+    """A compiled function of :mod:`beam_element.contact_kernel`, or None without numba."""
+    try:
+        from beam_element import contact_kernel
+    except ImportError:
+        return None
+    return getattr(contact_kernel, name)
 
 
 def _closest_point_kernel():
-    """The compiled kernel (:mod:`beam_element.contact_kernel`), or None without numba."""
-    if not _KERNEL:
-        try:
-            from beam_element.contact_kernel import closest_point_kernel
-        except ImportError:
-            closest_point_kernel = None
-        _KERNEL.append(closest_point_kernel)
-    return _KERNEL[0]
+    """The compiled closest-point kinematics, or None without numba."""
+    return _contact_kernel("closest_point_kernel")
 
 
 def _penalty_kernel():
-    """The compiled penalty blocks (:mod:`beam_element.contact_kernel`), or None without numba."""
-    if not _PENALTY:
-        try:
-            from beam_element.contact_kernel import penalty_blocks
-        except ImportError:
-            penalty_blocks = None
-        _PENALTY.append(penalty_blocks)
-    return _PENALTY[0]
-
-
-_PENALTY: list = []
+    """The compiled penalty blocks, or None without numba."""
+    return _contact_kernel("penalty_blocks")
 
 
 def _compact_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> _Compact:

@@ -56,9 +56,8 @@ from sandwich.solver.jit import njit
 
 __all__ = ["KernelOperators", "add_reduced", "block_pattern", "block_slots", "embed_pattern",
            "kernel_operators", "layer_assemble", "layer_blocks", "layer_flops", "layer_response",
-           "point_flops",
-           "scatter_blocks", "scatter_compact", "scatter_compact_known", "supports",
-           "uses_sum_factorisation"]
+           "point_flops", "scatter_blocks", "scatter_compact", "scatter_compact_known",
+           "supports", "uses_sum_factorisation"]
 
 
 @dataclass(frozen=True)

@@ -295,13 +295,18 @@ class _StepSize:
                              f"{h_min}, {h}, {h_max}")
         return cls(h, h_min, h_max, opt.desired_iterations)
 
-    def after(self, h_try: float, iterations: int, cuts: int) -> None:
-        """The increment of the next step after one of ``h_try`` converged."""
+    def after(self, h_try: float, iterations: int, cuts: int, all_iterations: int) -> None:
+        """The increment of the next step after one of ``h_try`` converged.
+
+        ``iterations``: those the step is weighed by (:meth:`_Follower._weighed_iterations`),
+        fewer than ``all_iterations`` where the settling allowance applied (:attr:`by_allowance`).
+        """
         factor = math.sqrt(self.desired_iterations / max(iterations, 1))
         factor = min(max(factor, 0.5), 2.0)
         if cuts:
             factor = min(factor, 1.0)
         self.h = min(max(h_try * factor, self.h_min), self.h_max)
+        self.by_allowance = iterations < all_iterations and not cuts
 
 
 class _Follower:
@@ -309,8 +314,6 @@ class _Follower:
 
     failed_once = False  # a corrector of this path has failed
     curve_probe: tuple[str | None, float] = (None, 0.0)  # set once the linear solution is known
-    states: list[PathState]
-    lam_est = 1.0
 
     @property
     def limit_corrections(self) -> bool:
@@ -448,9 +451,7 @@ class _Follower:
                 return self.finish(True, done)
             if crossed:
                 return self._finish_crossed(crossed)
-            weighed = self._weighed_iterations(trial)
-            size.after(h_try, weighed, cuts)
-            size.by_allowance = weighed < trial.iterations and not cuts  # grown by it
+            size.after(h_try, self._weighed_iterations(trial), cuts, trial.iterations)
         s = self.states[-1]
         return self.finish(False, (
             f"max_steps = {opt.max_steps} reached at λ = {s.load_factor:.6g} "
