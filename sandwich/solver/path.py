@@ -38,8 +38,10 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
   ``settling_allowance`` k (off unless a model sets it; the beam sets 2), ``iterations`` is at
   most the corrector's iterations until its increment test first passed plus k, as long as no
   corrector of the path has failed and the load curve's last two steps turn by less than
-  ``SETTLING_BEND``; a step so grown whose secant turns from its predictor by more is cut
-  (docs/solver.md, "Settling iterations").
+  ``SETTLING_BEND``; a step so grown whose secant turns from its predictor by more is cut,
+  and its converged state is then the step after the retry where it lies ahead of the
+  retry's state within ``HALF_REACH`` × the retry's length (docs/solver.md, "Settling
+  iterations").
 
 ψ (:attr:`PathOptions.arc_load_weight` × ``‖K(0)⁻¹ f_ref‖``) converts λ into displacement units,
 so in the linear range the λ and u parts of the arc weigh the same.
@@ -93,6 +95,10 @@ BENT = "the load curve bends within a step the settling allowance grew"  # that 
 #: path's last two steps turn by less than this angle (radians) in the plane of its load curve
 #: (:meth:`_Follower._straight`; docs/solver.md, "Settling iterations").
 SETTLING_BEND = math.radians(2.0)
+#: A step cut as BENT: its converged state is the step after the retry where it lies at most
+#: this many times as far from the retry's state as that from their start (at least 1 by the
+#: triangle inequality, 1 where the two halves are collinear; 1.25: halves turning by < 30°).
+HALF_REACH = 1.25
 
 
 @dataclass
@@ -451,7 +457,12 @@ class _Follower:
                 return self.finish(True, done)
             if crossed:
                 return self._finish_crossed(crossed)
-            size.after(h_try, self._weighed_iterations(trial), cuts, trial.iterations)
+            if trial is self.__dict__.pop("kept_half", None):
+                # its corrector's iterations were a whole bent step's, from the state before:
+                # the increment stays as the retry's left it, not grown
+                size.by_allowance = False
+            else:
+                size.after(h_try, self._weighed_iterations(trial), cuts, trial.iterations)
         s = self.states[-1]
         return self.finish(False, (
             f"max_steps = {opt.max_steps} reached at λ = {s.load_factor:.6g} "
@@ -477,9 +488,15 @@ class _Follower:
             if sign is not None:  # towards a directly controlled target
                 self.sigma = sign
             limit = self.limit_corrections and not limited_failed
+            kept = self._bent_half(last) if cuts == 0 and not direct else None
+            if kept is not None:  # the far half of the last step's bent one: converged already
+                self.kept_half = kept
+                return kept, self.wnorm(kept.u - last.u, kept.load_factor - last.load_factor), \
+                    False, 0
             trial, reason = self._attempt(h_try, last, t, rises, limit)
             if (trial is not None and size.by_allowance and cuts == 0 and not direct
                     and self._bends_within(last, trial, t)):
+                self.bent = (last.step, trial)  # its state may end the cut retry's next step
                 trial, reason = None, BENT
             if trial is not None and cuts < CRITICAL_TARGET_CUTS and 0.5 * h_try >= size.h_min \
                     and self._hard_across_target(last, trial):
@@ -523,6 +540,40 @@ class _Follower:
                         f"{cuts} time(s), last to {h_try:.3g}, and may not go below "
                         f"min_increment = {size.h_min:.3g}; "
                         f"last reason: {reason}.{hint}")
+
+    def _bent_half(self, last: PathState) -> _Trial | None:
+        """The converged state of a step cut as ``BENT``, as the step after its retry.
+
+        A step the settling allowance grew converged at X but bent within it (:data:`BENT`);
+        it was cut, and its retry from the same start at half the length converged at
+        ``last``. X is an equilibrium of the same path (the corrector converged there, under
+        the same guards) ahead of ``last``: it is taken as the next state where it lies at most
+        :data:`HALF_REACH` × as far from ``last`` as ``last`` from the bent step's start (so
+        the knee is sampled by the two halves the cut asked for), its displacement increment
+        makes an angle of at most 90° with the retry's (:meth:`_turns_back`'s test, with
+        ``min_step_cosine``) and no stopping target lies between (:meth:`_crossings`); else the
+        path steps on as usual. Saves the corrector that repeats the second half (fig. 5 at the
+        paper's core: 107 corrector iterations in all instead of 115). The next increment is the
+        one the retry left (X's iterations were a whole step's from the bent step's start).
+        Taken once: the kept state is dropped at any other step.
+        """
+        kept = self.__dict__.pop("bent", None)
+        if kept is None or len(self.states) < 2:
+            return None
+        start_step, trial = kept
+        start = self.states[-2]
+        if start.step != start_step or last is not self.states[-1]:
+            return None
+        du, dl = trial.u - last.u, trial.load_factor - last.load_factor
+        half = self.wnorm(last.u - start.u, last.load_factor - start.load_factor)
+        prev = last.u - start.u
+        denom = math.sqrt(self.dot(du, du) * self.dot(prev, prev))
+        if not (0.0 < self.wnorm(du, dl) <= HALF_REACH * half and denom > 0.0
+                and self.dot(du, prev) >= self.opt.min_step_cosine * denom):
+            return None
+        if self._crossings(last, trial):
+            return None
+        return trial
 
     def _hard_across_target(self, last: PathState, trial: _Trial) -> bool:
         """Whether ``trial`` crossed a critical point and a stopping target, the hard way.

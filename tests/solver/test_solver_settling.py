@@ -21,7 +21,7 @@ import pytest
 
 from sandwich.scene_file import load_scene
 from sandwich.solver import PathOptions
-from sandwich.solver.path import SETTLING_BEND, PathState, _Follower, _Trial
+from sandwich.solver.path import HALF_REACH, SETTLING_BEND, PathState, _Follower, _Trial
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
@@ -129,3 +129,78 @@ def test_an_allowance_of_max_iterations_is_the_controller_without_it():
     off = run(dataclasses.replace(scene, beam_model=dataclasses.replace(
         scene.beam_model, settling_allowance=scene.analysis.max_iterations))).solution
     assert [s.load_factor for s in off.history] == [s.load_factor for s in plain.history]
+
+
+def _bent_follower():
+    """A follower at the retry's state M of a step cut as BENT from ``start``, with the bent
+    step's converged state X kept: the path w ↦ λ with M at (−1, 1) (ψ = 1, one DOF u = w)."""
+    f = _Follower.__new__(_Follower)
+    f.opt = PathOptions(settling_allowance=2, until_probe="w", until_value=-10.0)
+    f.c, f.dot, f.psi = {"w": np.ones(1)}, np.dot, 1.0
+    f.states = [PathState(0, np.zeros(1), 0.0, 0, {"w": 0.0}, 0),
+                PathState(1, np.array([-1.0]), 1.0, 5, {"w": -1.0}, 0, 1)]
+    return f
+
+
+def _kept(f, w, lam, start_step=0):
+    x = _Trial(np.array([w]), lam, 9, None)
+    f.bent = (start_step, x)
+    return x
+
+
+def test_the_bent_steps_state_is_the_retrys_next_state_where_it_lies_ahead_within_reach():
+    """|M − start| = √2; X is taken when |X − M| ≤ HALF_REACH √2, ahead of M (Δu·(M − start)
+    ≥ 0), no target between; once only, and only after the retry from the bent step's start."""
+    f = _bent_follower()
+    x = _kept(f, -2.0, 2.1)  # |X − M| = √(1 + 1.21): within 1.25 √2 = 1.77
+    assert f._bent_half(f.states[-1]) is x
+    assert f._bent_half(f.states[-1]) is None  # taken once
+    far = math.sqrt((HALF_REACH * math.sqrt(2.0)) ** 2 - 1.0)  # |X − M| just beyond the reach
+    _kept(f, -2.0, 1.0 + 1.001 * far)
+    assert f._bent_half(f.states[-1]) is None
+    _kept(f, -2.0, 1.0 + 0.999 * far)
+    assert f._bent_half(f.states[-1]) is not None
+    _kept(f, -0.5, 1.5)  # Δu = +0.5 against the retry's −1: behind M
+    assert f._bent_half(f.states[-1]) is None
+    _kept(f, -2.0, 2.0, start_step=1)  # kept from another start than the retry's
+    assert f._bent_half(f.states[-1]) is None
+    f.opt = PathOptions(settling_allowance=2, until_probe="w", until_value=-1.5)
+    _kept(f, -2.0, 2.0)  # the target w = −1.5 lies between M and X: the target logic's
+    assert f._bent_half(f.states[-1]) is None
+
+
+def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends(monkeypatch):
+    """fig. 5 at the paper's core (240 elements): the step grown across the debonded face's
+    buckling is cut as BENT; with its state kept after the retry the path takes that state as
+    a step, spends fewer corrector iterations, and ends at the equilibrium the path without
+    the kept state (HALF_REACH = 0: never taken) ends at."""
+    from beam_element import run
+    from sandwich.solver import path as path_module
+    scene = load_scene(SCENES / "paper-fig5-top-debond-40-load-top.toml")
+    scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, core=1, core_zones=()))
+    spent, taken = [0], []
+    correct, bent_half = path_module.newton_correct, _Follower._bent_half
+
+    def counted(*args, **kwargs):
+        res = correct(*args, **kwargs)
+        spent[-1] += res.iterations
+        return res
+
+    def recorded(self, last):
+        kept = bent_half(self, last)
+        taken.append(kept)
+        return kept
+
+    monkeypatch.setattr(path_module, "newton_correct", counted)
+    monkeypatch.setattr(_Follower, "_bent_half", recorded)
+    kept = run(scene).solution
+    monkeypatch.setattr(path_module, "HALF_REACH", 0.0)
+    spent.append(0)
+    plain = run(scene).solution
+    assert kept.converged and plain.converged
+    states = [t for t in taken if t is not None]
+    assert len(states) == 1  # fig. 5's one bent step, taken in the first run only
+    assert states[0].load_factor in [s.load_factor for s in kept.history]
+    assert spent[0] < spent[1]
+    assert kept.final_load_factor == pytest.approx(plain.final_load_factor, rel=1e-9)
