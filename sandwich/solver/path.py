@@ -40,8 +40,8 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
   corrector of the path has failed and the load curve's last two steps turn by less than
   ``SETTLING_BEND``; a step so grown whose secant turns from its predictor by more is cut,
   and its converged state is then the step after the retry where it lies ahead of the
-  retry's state within ``HALF_REACH`` × the retry's length (docs/solver.md, "Settling
-  iterations").
+  retry's state within ``HALF_REACH`` × the increment the controller asks for then
+  (docs/solver.md, "Settling iterations").
 
 ψ (:attr:`PathOptions.arc_load_weight` × ``‖K(0)⁻¹ f_ref‖``) converts λ into displacement units,
 so in the linear range the λ and u parts of the arc weigh the same.
@@ -95,9 +95,9 @@ BENT = "the load curve bends within a step the settling allowance grew"  # that 
 #: path's last two steps turn by less than this angle (radians) in the plane of its load curve
 #: (:meth:`_Follower._straight`; docs/solver.md, "Settling iterations").
 SETTLING_BEND = math.radians(2.0)
-#: A step cut as BENT: its converged state is the step after the retry where it lies at most
-#: this many times as far from the retry's state as that from their start (at least 1 by the
-#: triangle inequality, 1 where the two halves are collinear; 1.25: halves turning by < 30°).
+#: A step cut as BENT: its converged state is the step after the retry where that step is at
+#: most this many times the increment the step-size controller asks for then
+#: (:meth:`_Follower._bent_half`).
 HALF_REACH = 1.25
 
 
@@ -488,11 +488,10 @@ class _Follower:
             if sign is not None:  # towards a directly controlled target
                 self.sigma = sign
             limit = self.limit_corrections and not limited_failed
-            kept = self._bent_half(last) if cuts == 0 and not direct else None
+            kept = self._bent_half(last, h_try) if cuts == 0 and not direct else None
             if kept is not None:  # the far half of the last step's bent one: converged already
                 self.kept_half = kept
-                return kept, self.wnorm(kept.u - last.u, kept.load_factor - last.load_factor), \
-                    False, 0
+                return kept, self._increment(last, kept), False, 0
             trial, reason = self._attempt(h_try, last, t, rises, limit)
             if (trial is not None and size.by_allowance and cuts == 0 and not direct
                     and self._bends_within(last, trial, t)):
@@ -541,21 +540,22 @@ class _Follower:
                         f"min_increment = {size.h_min:.3g}; "
                         f"last reason: {reason}.{hint}")
 
-    def _bent_half(self, last: PathState) -> _Trial | None:
+    def _bent_half(self, last: PathState, h: float) -> _Trial | None:
         """The converged state of a step cut as ``BENT``, as the step after its retry.
 
         A step the settling allowance grew converged at X but bent within it (:data:`BENT`);
         it was cut, and its retry from the same start at half the length converged at
         ``last``. X is an equilibrium of the same path (the corrector converged there, under
-        the same guards) ahead of ``last``: it is taken as the next state where it lies at most
-        :data:`HALF_REACH` × as far from ``last`` as ``last`` from the bent step's start (so
-        the knee is sampled by the two halves the cut asked for), its displacement increment
-        makes an angle of at most 90° with the retry's (:meth:`_turns_back`'s test, with
-        ``min_step_cosine``) and no stopping target lies between (:meth:`_crossings`); else the
-        path steps on as usual. Saves the corrector that repeats the second half (fig. 5 at the
-        paper's core: 107 corrector iterations in all instead of 115). The next increment is the
-        one the retry left (X's iterations were a whole step's from the bent step's start).
-        Taken once: the kept state is dropped at any other step.
+        the same guards) ahead of ``last``: it is taken as the next step where that step is no
+        longer than :data:`HALF_REACH` × the increment ``h`` the controller asks for now (in
+        the units of the control, :meth:`_increment`: the path is sampled as finely as the
+        controller's own step would sample it), its displacement increment makes an angle of
+        at most 90° with the retry's (:meth:`_turns_back`'s test, with ``min_step_cosine``)
+        and no stopping target lies between (:meth:`_crossings`); else the path steps on as
+        usual. Saves the corrector that repeats the second half (fig. 5 at the paper's core:
+        107 corrector iterations in all instead of 115). The increment after it is the one the
+        retry left (X's iterations were a whole step's, from the bent step's start). Taken
+        once: the kept state is dropped at any other step.
         """
         kept = self.__dict__.pop("bent", None)
         if kept is None or len(self.states) < 2:
@@ -564,16 +564,25 @@ class _Follower:
         start = self.states[-2]
         if start.step != start_step or last is not self.states[-1]:
             return None
-        du, dl = trial.u - last.u, trial.load_factor - last.load_factor
-        half = self.wnorm(last.u - start.u, last.load_factor - start.load_factor)
+        du = trial.u - last.u
         prev = last.u - start.u
         denom = math.sqrt(self.dot(du, du) * self.dot(prev, prev))
-        if not (0.0 < self.wnorm(du, dl) <= HALF_REACH * half and denom > 0.0
+        if not (0.0 < self._increment(last, trial) <= HALF_REACH * h and denom > 0.0
                 and self.dot(du, prev) >= self.opt.min_step_cosine * denom):
             return None
         if self._crossings(last, trial):
             return None
         return trial
+
+    def _increment(self, last: PathState, trial: _Trial) -> float:
+        """The step from ``last`` to ``trial`` in the units of the control (h's)."""
+        dl = trial.load_factor - last.load_factor
+        if self.opt.control == "load":
+            return abs(dl)
+        if self.opt.control == "displacement":
+            name = self.opt.driven_probe
+            return abs(self._value(name, trial.u, 0.0) - last.probes[name])
+        return self.wnorm(trial.u - last.u, dl)
 
     def _hard_across_target(self, last: PathState, trial: _Trial) -> bool:
         """Whether ``trial`` crossed a critical point and a stopping target, the hard way.

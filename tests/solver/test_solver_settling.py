@@ -131,11 +131,12 @@ def test_an_allowance_of_max_iterations_is_the_controller_without_it():
     assert [s.load_factor for s in off.history] == [s.load_factor for s in plain.history]
 
 
-def _bent_follower():
+def _bent_follower(control="arc-length"):
     """A follower at the retry's state M of a step cut as BENT from ``start``, with the bent
     step's converged state X kept: the path w ↦ λ with M at (−1, 1) (ψ = 1, one DOF u = w)."""
     f = _Follower.__new__(_Follower)
-    f.opt = PathOptions(settling_allowance=2, until_probe="w", until_value=-10.0)
+    f.opt = PathOptions(control=control, settling_allowance=2, until_probe="w",
+                        until_value=-10.0)
     f.c, f.dot, f.psi = {"w": np.ones(1)}, np.dot, 1.0
     f.states = [PathState(0, np.zeros(1), 0.0, 0, {"w": 0.0}, 0),
                 PathState(1, np.array([-1.0]), 1.0, 5, {"w": -1.0}, 0, 1)]
@@ -148,25 +149,34 @@ def _kept(f, w, lam, start_step=0):
     return x
 
 
-def test_the_bent_steps_state_is_the_retrys_next_state_where_it_lies_ahead_within_reach():
-    """|M − start| = √2; X is taken when |X − M| ≤ HALF_REACH √2, ahead of M (Δu·(M − start)
-    ≥ 0), no target between; once only, and only after the retry from the bent step's start."""
+def test_the_bent_steps_state_is_the_retrys_next_state_within_the_controllers_increment():
+    """X is taken when the step M → X is at most HALF_REACH × the increment h the controller
+    asks for (in the control's units: the arc ‖(Δu, ψΔλ)‖, Δλ under load control), ahead of M
+    (Δu·(M − start) ≥ 0) and with no target between; once only, and only right after the
+    retry from the bent step's start."""
     f = _bent_follower()
-    x = _kept(f, -2.0, 2.1)  # |X − M| = √(1 + 1.21): within 1.25 √2 = 1.77
-    assert f._bent_half(f.states[-1]) is x
-    assert f._bent_half(f.states[-1]) is None  # taken once
-    far = math.sqrt((HALF_REACH * math.sqrt(2.0)) ** 2 - 1.0)  # |X − M| just beyond the reach
+    h = 1.0
+    x = _kept(f, -2.0, 1.5)  # |X − M| = √1.25 = 1.118 h
+    assert f._bent_half(f.states[-1], h) is x
+    assert f._bent_half(f.states[-1], h) is None  # taken once
+    far = math.sqrt(HALF_REACH**2 - 1.0)  # Δλ putting |X − M| at HALF_REACH h
     _kept(f, -2.0, 1.0 + 1.001 * far)
-    assert f._bent_half(f.states[-1]) is None
+    assert f._bent_half(f.states[-1], h) is None
     _kept(f, -2.0, 1.0 + 0.999 * far)
-    assert f._bent_half(f.states[-1]) is not None
+    assert f._bent_half(f.states[-1], h) is not None
     _kept(f, -0.5, 1.5)  # Δu = +0.5 against the retry's −1: behind M
-    assert f._bent_half(f.states[-1]) is None
-    _kept(f, -2.0, 2.0, start_step=1)  # kept from another start than the retry's
-    assert f._bent_half(f.states[-1]) is None
-    f.opt = PathOptions(settling_allowance=2, until_probe="w", until_value=-1.5)
-    _kept(f, -2.0, 2.0)  # the target w = −1.5 lies between M and X: the target logic's
-    assert f._bent_half(f.states[-1]) is None
+    assert f._bent_half(f.states[-1], h) is None
+    _kept(f, -2.0, 1.5, start_step=1)  # kept from another start than the retry's
+    assert f._bent_half(f.states[-1], h) is None
+    f.opt = PathOptions(control="arc-length", settling_allowance=2, until_probe="w",
+                        until_value=-1.5)
+    _kept(f, -2.0, 1.5)  # the target w = −1.5 lies between M and X: the target logic's
+    assert f._bent_half(f.states[-1], h) is None
+    f = _bent_follower(control="load")  # the increment is Δλ: 1.2 ≤ 1.25 × 1, 1.3 is not
+    _kept(f, -5.0, 2.2)
+    assert f._bent_half(f.states[-1], h) is not None
+    _kept(f, -5.0, 2.3)
+    assert f._bent_half(f.states[-1], h) is None
 
 
 def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends(monkeypatch):
@@ -187,8 +197,8 @@ def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends
         spent[-1] += res.iterations
         return res
 
-    def recorded(self, last):
-        kept = bent_half(self, last)
+    def recorded(self, last, h):
+        kept = bent_half(self, last, h)
         taken.append(kept)
         return kept
 
