@@ -320,6 +320,8 @@ class _Follower:
 
     failed_once = False  # a corrector of this path has failed
     curve_probe: tuple[str | None, float] = (None, 0.0)  # set once the linear solution is known
+    bent: tuple[int, _Trial] | None = None  # (start step, converged state) of a step cut as BENT
+    kept_half: _Trial | None = None  # that state, while it is the step being accepted
 
     @property
     def limit_corrections(self) -> bool:
@@ -457,7 +459,8 @@ class _Follower:
                 return self.finish(True, done)
             if crossed:
                 return self._finish_crossed(crossed)
-            if trial is self.__dict__.pop("kept_half", None):
+            kept, self.kept_half = self.kept_half, None
+            if trial is kept:
                 # its corrector's iterations were a whole bent step's, from the state before:
                 # the increment stays as the retry's left it, not grown
                 size.by_allowance = False
@@ -557,20 +560,17 @@ class _Follower:
         retry left (X's iterations were a whole step's, from the bent step's start). Taken
         once: the kept state is dropped at any other step.
         """
-        kept = self.__dict__.pop("bent", None)
+        kept, self.bent = self.bent, None
         if kept is None or len(self.states) < 2:
             return None
         start_step, trial = kept
         start = self.states[-2]
         if start.step != start_step or last is not self.states[-1]:
             return None
-        du = trial.u - last.u
-        prev = last.u - start.u
-        denom = math.sqrt(self.dot(du, du) * self.dot(prev, prev))
-        if not (0.0 < self._increment(last, trial) <= HALF_REACH * h and denom > 0.0
-                and self.dot(du, prev) >= self.opt.min_step_cosine * denom):
-            return None
-        if self._crossings(last, trial):
+        cos = self._step_cosine(trial.u - last.u, last.u - start.u)
+        if (cos is None or cos < self.opt.min_step_cosine
+                or not 0.0 < self._increment(last, trial) <= HALF_REACH * h
+                or self._crossings(last, trial)):
             return None
         return trial
 
@@ -844,11 +844,8 @@ class _Follower:
         if self.prev_step is None or self.opt.min_step_cosine <= -1.0:
             return ""
         prev = self.prev_step[0]
-        denom = math.sqrt(self.dot(du, du) * self.dot(prev, prev))
-        if not denom > 0.0:
-            return ""
-        cos = self.dot(du, prev) / denom
-        if cos >= self.opt.min_step_cosine:
+        cos = self._step_cosine(du, prev)
+        if cos is None or cos >= self.opt.min_step_cosine:
             return ""
         pred_back = self.dot(du_pred, prev) < 0.0
         if pred_back and self.opt.control == "arc-length":
@@ -857,6 +854,11 @@ class _Follower:
                 f"{math.degrees(math.acos(max(-1.0, min(1.0, cos)))):.0f}° with the previous "
                 f"step's (retrace or jump to another branch"
                 f"{'; predictor pointed backwards, sign flipped' if pred_back else ''})")
+
+    def _step_cosine(self, du: np.ndarray, prev: np.ndarray) -> float | None:
+        """The cosine of the angle between two displacement increments (None if one is zero)."""
+        denom = math.sqrt(self.dot(du, du) * self.dot(prev, prev))
+        return self.dot(du, prev) / denom if denom > 0.0 else None
 
     def _crossings(self, last: PathState, trial: _Trial) -> list[tuple[float, str, float]]:
         """Targets crossed between ``last`` and ``trial``: (linear fraction, name, target)."""
