@@ -36,6 +36,30 @@ def hermite_w_row(mesh: BeamMesh, face: str, x: float) -> tuple[np.ndarray, np.n
     return np.array(idx), np.array(val)
 
 
+def _elements_at(mesh: BeamMesh, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`BeamMesh.element_at` of points inside the beam, all at once (the same numbers)."""
+    e = np.clip(np.searchsorted(mesh.x, x, side="right") - 1, 0, mesh.n_elements - 1)
+    eta = 2.0 * (x - mesh.x[e]) / (mesh.x[e + 1] - mesh.x[e]) - 1.0
+    return e, np.clip(eta, -1.0, 1.0)
+
+
+def _patch_points(mesh: BeamMesh, start: float, end: float, order: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss points of [start, end] ∩ each element, element by element.
+
+    Returns the stretches' lengths b − a (per element met), the rule's weights, and the
+    points' elements and reference coordinates η (:meth:`BeamMesh.element_at`'s).
+    """
+    s, ws = gauss_legendre(order)
+    lo, hi = mesh.x[:-1], mesh.x[1:]
+    a, b = np.maximum(start, lo), np.minimum(end, hi)
+    hit = b > a
+    a, b, lo, hi = a[hit], b[hit], lo[hit], hi[hit]
+    xg = np.clip((0.5 * (a + b))[:, None] + (0.5 * (b - a))[:, None] * s, lo[:, None], hi[:, None])
+    e, eta = _elements_at(mesh, xg.ravel())
+    return b - a, ws, e, eta
+
+
 def point_load(mesh: BeamMesh, face: str, x: float, force: float) -> np.ndarray:
     """Full nodal load vector of a transverse force (N, +z) at ``x`` on a face."""
     f = np.zeros(20 * mesh.n_nodes)
@@ -45,21 +69,27 @@ def point_load(mesh: BeamMesh, face: str, x: float, force: float) -> np.ndarray:
 
 
 def patch_load(mesh: BeamMesh, face: str, start: float, end: float, force: float) -> np.ndarray:
-    """Consistent nodal loads of a uniform load of total ``force`` (N, +z) over [start, end]."""
+    """Consistent nodal loads of a uniform load of total ``force`` (N, +z) over [start, end].
+
+    3 Gauss points per element stretch (q × a cubic Hermite function: exact), evaluated at
+    once; the terms are added in the order of a loop over elements, points and the four
+    functions of eq. (13b,d), as :func:`hermite_w_row` gives them.
+    """
     _check_face(face)
     if not end > start:
         raise ValueError(f"a patch load needs end > start, got [{start}, {end}]")
     q = force / (end - start)  # N/mm
     f = np.zeros(20 * mesh.n_nodes)
-    s, ws = gauss_legendre(3)  # q Hermite is cubic: exact
-    for e in range(mesh.n_elements):
-        a, b = max(start, mesh.x[e]), min(end, mesh.x[e + 1])
-        if b <= a:
-            continue
-        xg = 0.5 * (a + b) + 0.5 * (b - a) * s
-        for xq, wq in zip(xg, ws, strict=True):
-            idx, val = hermite_w_row(mesh, face, float(np.clip(xq, mesh.x[e], mesh.x[e + 1])))
-            np.add.at(f, idx, q * 0.5 * (b - a) * wq * val)
+    length, ws, e, eta = _patch_points(mesh, start, end, 3)
+    idx, val = [], []
+    for kind, node, role in _HERMITE:
+        value, _ = x_shape(kind, node, eta)
+        scale = 0.5 * mesh.lengths[e] if kind == "Hbar" else 1.0  # Hbar(η; l) = (l/2) Hbar_ref
+        idx.append(global_dof(e + node, FACE_DOFS[face][role]))
+        val.append(scale * value)
+    idx, val = np.stack(idx, axis=1), np.stack(val, axis=1)  # (points, 4)
+    coef = (q * 0.5 * length)[:, None] * ws  # the loop's q (b − a)/2 w_g, in its order
+    np.add.at(f, idx.ravel(), (coef.reshape(-1, 1) * val).ravel())
     return f
 
 
@@ -92,17 +122,17 @@ def stretch_point_load(mesh: BeamMesh, x: float, force: float) -> np.ndarray:
 
 
 def stretch_patch_load(mesh: BeamMesh, start: float, end: float, force: float) -> np.ndarray:
-    """The same for a uniform load of total ``force`` over [start, end] (per node)."""
+    """The same for a uniform load of total ``force`` over [start, end] (per node).
+
+    2 Gauss points per element stretch (q times a linear function: exact), evaluated at once.
+    """
     if not end > start:
         raise ValueError(f"a patch load needs end > start, got [{start}, {end}]")
     q = force / (end - start)
     f = np.zeros(mesh.n_nodes)
-    s, ws = gauss_legendre(2)  # q times a linear function: exact
-    for e in range(mesh.n_elements):
-        a, b = max(start, mesh.x[e]), min(end, mesh.x[e + 1])
-        if b <= a:
-            continue
-        for xq, wq in zip(0.5 * (a + b) + 0.5 * (b - a) * s, ws, strict=True):
-            idx, val = stretch_row(mesh, float(np.clip(xq, mesh.x[e], mesh.x[e + 1])))
-            np.add.at(f, idx, q * 0.5 * (b - a) * wq * val)
+    length, ws, e, eta = _patch_points(mesh, start, end, 2)
+    idx = np.stack([e, e + 1], axis=1)
+    val = np.stack([0.5 * (1 - eta), 0.5 * (1 + eta)], axis=1)
+    coef = (q * 0.5 * length)[:, None] * ws
+    np.add.at(f, idx.ravel(), (coef.reshape(-1, 1) * val).ravel())
     return f
