@@ -667,6 +667,10 @@ def _column_ldlt(env, colptr, last, n):  # pragma: no cover - compiled
         a0, a1, a2, a3 = last[j], last[j + 1], last[j + 2], last[j + 3]
         c0_, c1_, c2_, c3_ = colptr[j], colptr[j + 1], colptr[j + 2], colptr[j + 3]
         d0, d1, d2, d3 = env[c0_], env[c1_], env[c2_], env[c3_]
+        if a0 == a3:  # the four columns end on one row: trailing columns in pairs
+            _paired_update(env, colptr, j, a3, c0_, c1_, c2_, c3_, d0, d1, d2, d3)
+            j += 4
+            continue
         for k in range(j + 4, a3 + 1):  # the trailing columns the panel reaches
             c0 = env[c0_ + (k - j)] * d0 if k <= a0 else 0.0
             c1 = env[c1_ + (k - j - 1)] * d1 if k <= a1 else 0.0
@@ -706,6 +710,41 @@ def _column_ldlt(env, colptr, last, n):  # pragma: no cover - compiled
     if not finite:
         dmin = np.nan
     return negative, dmin, ldmax, lmax
+
+
+@njit
+def _paired_update(env, colptr, j, A, c0_, c1_, c2_, c3_, d0, d1, d2, d3):  # pragma: no cover
+    """:func:`_column_ldlt`'s rank-4 update by a panel whose four columns all end on row A.
+
+    The trailing columns j + 4 … A lose the panel's terms (the common case: a node's DOFs
+    share their last coupled row; fig. 5 at level 1: two panels in three). Columns k and k + 1
+    go together: each source entry (the panel's l_rp, rows k + 1 … A) is read once for both.
+    Every entry gets the same operations as one column at a time, so the same values bit for
+    bit (fig. 5, 240 elements, level 1: 0.47 → 0.39 ms a factorisation).
+    """
+    o0, o1, o2, o3 = c0_ - j, c1_ - j - 1, c2_ - j - 2, c3_ - j - 3  # env[o_p + r]: row r of p
+    k = j + 4
+    while k <= A:
+        e0, e1 = env[o0 + k] * d0, env[o1 + k] * d1  # column k's coefficients (l_kp d_p)
+        e2, e3 = env[o2 + k] * d2, env[o3 + k] * d3
+        ck = colptr[k] - k  # env[ck + r] = column k, row r
+        env[ck + k] -= e0 * env[o0 + k] + e1 * env[o1 + k] + e2 * env[o2 + k] + e3 * env[o3 + k]
+        if k == A:
+            break
+        f0, f1 = env[o0 + k + 1] * d0, env[o1 + k + 1] * d1  # column k + 1's
+        f2, f3 = env[o2 + k + 1] * d2, env[o3 + k + 1] * d3
+        ck1 = colptr[k + 1] - k - 1
+        dk = env[ck + k + 1:ck + A + 1]
+        dk1 = env[ck1 + k + 1:ck1 + A + 1]
+        s0 = env[o0 + k + 1:o0 + A + 1]
+        s1 = env[o1 + k + 1:o1 + A + 1]
+        s2 = env[o2 + k + 1:o2 + A + 1]
+        s3 = env[o3 + k + 1:o3 + A + 1]
+        for t in range(A - k):
+            v0, v1, v2, v3 = s0[t], s1[t], s2[t], s3[t]
+            dk[t] -= e0 * v0 + e1 * v1 + e2 * v2 + e3 * v3
+            dk1[t] -= f0 * v0 + f1 * v1 + f2 * v2 + f3 * v3
+        k += 2
 
 
 #: Columns per panel of :func:`_panel_ldlt` (its trailing update is a rank-8 update).

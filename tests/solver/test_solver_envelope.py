@@ -94,6 +94,54 @@ def _column_factors(fac):
     return L, D
 
 
+def _node_blocks(rng, sizes):
+    """Random symmetric indefinite block-tridiagonal matrix of node blocks of ``sizes``: a
+    node's rows coupled to the whole node before it (a beam's nodes), so every column of a
+    node ends on the same row — the column kernel's paired update (panels of four within a
+    node) — and panels across two nodes take its general one."""
+    ends = np.cumsum(sizes)
+    starts = ends - sizes
+    rows, cols = [], []
+    for b, (s0, s1) in enumerate(zip(starts, ends, strict=True)):
+        lo = starts[b - 1] if b else s0
+        for i in range(s0, s1):
+            rows += [i] * (i - lo)
+            cols += list(range(lo, i))
+    n = int(ends[-1])
+    L = sp.csr_matrix((rng.normal(size=len(rows)), (rows, cols)), shape=(n, n))
+    return (L + L.T + sp.diags(rng.normal(scale=3.0, size=n))).tocsr()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_column_kernel_on_node_blocks_gives_the_inertia_and_small_backward_error(
+        seed, monkeypatch):
+    """The column kernel (narrow columns) where panels of four end on one row, so trailing
+    columns are updated in pairs (`_paired_update`, an odd one alone at the end), mixed with
+    panels that do not: negative pivots against eigvalsh, solves against the dense matrix, and
+    the factors' backward error within Higham's bound."""
+    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)  # column storage, natural order
+    rng = np.random.default_rng(200 + seed)
+    sizes = rng.choice([4, 8] if seed < 3 else [3, 4, 5, 7], size=int(rng.integers(8, 30)))
+    A = _node_blocks(rng, sizes)
+    A.sort_indices()
+    s = EnvelopeStructure.of(A, ordering="natural")
+    assert s.storage == "columns" and not s.panels
+    equal = [j for j in range(0, s.n - 3, 4) if s.last[j] == s.last[j + 3]]
+    assert equal  # the paired update runs
+    n = s.n
+    eig = np.linalg.eigvalsh(A.toarray())
+    fac = factorize_envelope(A, s)
+    assert isinstance(fac, EnvelopeFactorization)
+    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
+    b = rng.normal(size=(n, 2))
+    cond = np.abs(eig).max() / np.abs(eig).min()
+    assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
+    L, D = _column_factors(fac)
+    K = A.toarray()
+    gamma = n * np.finfo(float).eps / 2 / (1 - n * np.finfo(float).eps / 2)
+    assert np.all(np.abs(K - (L * D) @ L.T) <= gamma * (np.abs(L) * np.abs(D)) @ np.abs(L).T)
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_panels_on_narrow_bands_too(seed, monkeypatch):
     """Forced onto the small random envelopes (every width, panels wider than the band)."""
