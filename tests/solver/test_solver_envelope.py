@@ -68,6 +68,15 @@ def test_panels_give_the_inertia_and_solves_of_dense_lapack(seed, monkeypatch):
     monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)  # column storage
     s = EnvelopeStructure.of(A)
     assert s.storage == "columns" and s.panels and s.n % envelope.PANEL
+    _check_column_factorisation(A, s, rng)
+
+
+def _check_column_factorisation(A, s, rng):
+    """Factorise ``A`` in the column-storage structure ``s``: negative pivots against eigvalsh,
+    two solves against the dense matrix, and the factors' backward error within Higham's
+    bound (Thm 10.3 for LDLᵀ without pivoting: |P K Pᵀ − L D Lᵀ| ≤ γ_n |L| |D| |Lᵀ| entry by
+    entry, γ_n = n u / (1 − n u))."""
+    n = s.n
     eig = np.linalg.eigvalsh(A.toarray())
     fac = factorize_envelope(A, s)
     assert isinstance(fac, EnvelopeFactorization)
@@ -75,8 +84,6 @@ def test_panels_give_the_inertia_and_solves_of_dense_lapack(seed, monkeypatch):
     b = rng.normal(size=(n, 2))
     cond = np.abs(eig).max() / np.abs(eig).min()
     assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
-    # backward error of the factors (Higham, Thm 10.3 for LDLᵀ without pivoting):
-    # |P K Pᵀ − L D Lᵀ| ≤ γ_n |L| |D| |Lᵀ| entry by entry, γ_n = n u / (1 − n u)
     L, D = _column_factors(fac)
     K = A.toarray()[np.ix_(s.order, s.order)]
     gamma = n * np.finfo(float).eps / 2 / (1 - n * np.finfo(float).eps / 2)
@@ -128,18 +135,7 @@ def test_column_kernel_on_node_blocks_gives_the_inertia_and_small_backward_error
     assert s.storage == "columns" and not s.panels
     equal = [j for j in range(0, s.n - 3, 4) if s.last[j] == s.last[j + 3]]
     assert equal  # the paired update runs
-    n = s.n
-    eig = np.linalg.eigvalsh(A.toarray())
-    fac = factorize_envelope(A, s)
-    assert isinstance(fac, EnvelopeFactorization)
-    assert fac.negative_pivots == int(np.count_nonzero(eig < 0))
-    b = rng.normal(size=(n, 2))
-    cond = np.abs(eig).max() / np.abs(eig).min()
-    assert np.linalg.norm(A @ fac.solve(b) - b) <= 1e-12 * cond * np.linalg.norm(b)
-    L, D = _column_factors(fac)
-    K = A.toarray()
-    gamma = n * np.finfo(float).eps / 2 / (1 - n * np.finfo(float).eps / 2)
-    assert np.all(np.abs(K - (L * D) @ L.T) <= gamma * (np.abs(L) * np.abs(D)) @ np.abs(L).T)
+    _check_column_factorisation(A, s, rng)
 
 
 @pytest.mark.parametrize("seed", range(4))
