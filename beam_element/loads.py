@@ -36,19 +36,12 @@ def hermite_w_row(mesh: BeamMesh, face: str, x: float) -> tuple[np.ndarray, np.n
     return np.array(idx), np.array(val)
 
 
-def _elements_at(mesh: BeamMesh, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:meth:`BeamMesh.element_at` of points inside the beam, all at once (the same numbers)."""
-    e = np.clip(np.searchsorted(mesh.x, x, side="right") - 1, 0, mesh.n_elements - 1)
-    eta = 2.0 * (x - mesh.x[e]) / (mesh.x[e + 1] - mesh.x[e]) - 1.0
-    return e, np.clip(eta, -1.0, 1.0)
-
-
 def _patch_points(mesh: BeamMesh, start: float, end: float, order: int
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Gauss points of [start, end] ∩ each element, element by element.
 
     Returns the stretches' lengths b − a (per element met), the rule's weights, and the
-    points' elements and reference coordinates η (:meth:`BeamMesh.element_at`'s).
+    points' elements and reference coordinates η (:meth:`BeamMesh.elements_at`).
     """
     s, ws = gauss_legendre(order)
     lo, hi = mesh.x[:-1], mesh.x[1:]
@@ -56,7 +49,7 @@ def _patch_points(mesh: BeamMesh, start: float, end: float, order: int
     hit = b > a
     a, b, lo, hi = a[hit], b[hit], lo[hit], hi[hit]
     xg = np.clip((0.5 * (a + b))[:, None] + (0.5 * (b - a))[:, None] * s, lo[:, None], hi[:, None])
-    e, eta = _elements_at(mesh, xg.ravel())
+    e, eta = mesh.elements_at(xg.ravel())
     return b - a, ws, e, eta
 
 

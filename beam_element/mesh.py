@@ -71,9 +71,14 @@ class BeamMesh:
         """Element containing ``x`` and the reference coordinate η of ``x`` in it."""
         if not (self.x[0] - 1e-12 * self.length <= x <= self.x[-1] + 1e-12 * self.length):
             raise ValueError(f"x = {x} lies outside the beam [{self.x[0]}, {self.x[-1]}]")
-        e = int(np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.n_elements - 1))
+        e, η = self.elements_at(np.array([x], dtype=float))
+        return int(e[0]), float(η[0])
+
+    def elements_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`element_at` of an array of points on the beam (not checked), all at once."""
+        e = np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.n_elements - 1)
         η = 2.0 * (x - self.x[e]) / (self.x[e + 1] - self.x[e]) - 1.0
-        return e, float(np.clip(η, -1.0, 1.0))
+        return e, np.clip(η, -1.0, 1.0)
 
 
 def _clean(points: Iterable[float], length: float, tol: float, what: str) -> np.ndarray:
