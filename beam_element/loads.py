@@ -36,12 +36,12 @@ def hermite_w_row(mesh: BeamMesh, face: str, x: float) -> tuple[np.ndarray, np.n
     return np.array(idx), np.array(val)
 
 
-def _patch_points(mesh: BeamMesh, start: float, end: float, order: int
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Gauss points of [start, end] ∩ each element, element by element.
+def _patch_points(mesh: BeamMesh, start: float, end: float, order: int, q: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss points of [start, end] ∩ each element, element by element, for a load q (N/mm).
 
-    Returns the stretches' lengths b − a (per element met), the rule's weights, and the
-    points' elements and reference coordinates η (:meth:`BeamMesh.elements_at`).
+    Returns each point's q (b − a)/2 w_g (its stretch [a, b], its weight; multiplied in that
+    order), element and reference coordinate η (:meth:`BeamMesh.elements_at`).
     """
     s, ws = gauss_legendre(order)
     lo, hi = mesh.x[:-1], mesh.x[1:]
@@ -50,7 +50,7 @@ def _patch_points(mesh: BeamMesh, start: float, end: float, order: int
     a, b, lo, hi = a[hit], b[hit], lo[hit], hi[hit]
     xg = np.clip((0.5 * (a + b))[:, None] + (0.5 * (b - a))[:, None] * s, lo[:, None], hi[:, None])
     e, eta = mesh.elements_at(xg.ravel())
-    return b - a, ws, e, eta
+    return ((q * 0.5 * (b - a))[:, None] * ws).ravel(), e, eta
 
 
 def point_load(mesh: BeamMesh, face: str, x: float, force: float) -> np.ndarray:
@@ -73,7 +73,7 @@ def patch_load(mesh: BeamMesh, face: str, start: float, end: float, force: float
         raise ValueError(f"a patch load needs end > start, got [{start}, {end}]")
     q = force / (end - start)  # N/mm
     f = np.zeros(20 * mesh.n_nodes)
-    length, ws, e, eta = _patch_points(mesh, start, end, 3)
+    coef, e, eta = _patch_points(mesh, start, end, 3, q)
     idx, val = [], []
     for kind, node, role in _HERMITE:
         value, _ = x_shape(kind, node, eta)
@@ -81,8 +81,7 @@ def patch_load(mesh: BeamMesh, face: str, start: float, end: float, force: float
         idx.append(global_dof(e + node, FACE_DOFS[face][role]))
         val.append(scale * value)
     idx, val = np.stack(idx, axis=1), np.stack(val, axis=1)  # (points, 4)
-    coef = (q * 0.5 * length)[:, None] * ws  # the loop's q (b − a)/2 w_g, in its order
-    np.add.at(f, idx.ravel(), (coef.reshape(-1, 1) * val).ravel())
+    np.add.at(f, idx.ravel(), (coef[:, None] * val).ravel())
     return f
 
 
@@ -123,9 +122,8 @@ def stretch_patch_load(mesh: BeamMesh, start: float, end: float, force: float) -
         raise ValueError(f"a patch load needs end > start, got [{start}, {end}]")
     q = force / (end - start)
     f = np.zeros(mesh.n_nodes)
-    length, ws, e, eta = _patch_points(mesh, start, end, 2)
+    coef, e, eta = _patch_points(mesh, start, end, 2, q)
     idx = np.stack([e, e + 1], axis=1)
     val = np.stack([0.5 * (1 - eta), 0.5 * (1 + eta)], axis=1)
-    coef = (q * 0.5 * length)[:, None] * ws
-    np.add.at(f, idx.ravel(), (coef.reshape(-1, 1) * val).ravel())
+    np.add.at(f, idx.ravel(), (coef[:, None] * val).ravel())
     return f

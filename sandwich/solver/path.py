@@ -561,12 +561,9 @@ class _Follower:
         once: the kept state is dropped at any other step.
         """
         kept, self.bent = self.bent, None
-        if kept is None or len(self.states) < 2:
-            return None
-        start_step, trial = kept
-        start = self.states[-2]
-        if start.step != start_step or last is not self.states[-1]:
-            return None
+        if kept is None or len(self.states) < 2 or self.states[-2].step != kept[0]:
+            return None  # nothing kept, or not right after the retry from the bent step's start
+        trial, start = kept[1], self.states[-2]
         cos = self._step_cosine(trial.u - last.u, last.u - start.u)
         if (cos is None or cos < self.opt.min_step_cosine
                 or not 0.0 < self._increment(last, trial) <= HALF_REACH * h
@@ -797,13 +794,12 @@ class _Follower:
         K⁻¹ f_ref at ``last``, either sense: a knee the step has crossed (the debonded face's
         buckling, a crushing) that the steps before it could not announce.
         """
-        name, scale = self.curve_probe
+        name = self.curve_probe[0]
         if name is None:
             return False
-        lam_scale = abs(self.lam_est) or 1.0
-        p = (self.dot(self.c[name], t) / scale, 1.0 / lam_scale)
-        d = ((self._value(name, trial.u, 0.0) - last.probes[name]) / scale,
-             (trial.load_factor - last.load_factor) / lam_scale)
+        p = self._in_curve_plane(self.dot(self.c[name], t), 1.0)
+        d = self._in_curve_plane(self._value(name, trial.u, 0.0) - last.probes[name],
+                                 trial.load_factor - last.load_factor)
         cos = _cosine(p, d)
         return cos is not None and abs(cos) < math.cos(SETTLING_BEND)
 
@@ -815,17 +811,18 @@ class _Follower:
         probe asked for (:attr:`curve_probe`). False with fewer than two steps, without a
         probe, or where the probe's linear value is zero.
         """
-        name, scale = self.curve_probe
+        name = self.curve_probe[0]
         if name is None or len(self.states) < 3:
             return False
-        lam_scale = abs(self.lam_est) or 1.0
         a, b, c = self.states[-3:]
-        d1 = ((b.probes[name] - a.probes[name]) / scale,
-              (b.load_factor - a.load_factor) / lam_scale)
-        d2 = ((c.probes[name] - b.probes[name]) / scale,
-              (c.load_factor - b.load_factor) / lam_scale)
+        d1 = self._in_curve_plane(b.probes[name] - a.probes[name], b.load_factor - a.load_factor)
+        d2 = self._in_curve_plane(c.probes[name] - b.probes[name], c.load_factor - b.load_factor)
         cos = _cosine(d1, d2)
         return cos is not None and cos >= math.cos(SETTLING_BEND)
+
+    def _in_curve_plane(self, dv: float, dlam: float) -> tuple[float, float]:
+        """A change (probe ``dv``, λ ``dlam``) in the scaled plane of :meth:`_straight`."""
+        return dv / self.curve_probe[1], dlam / (abs(self.lam_est) or 1.0)
 
     def _turns_back(self, du: np.ndarray, du_pred: np.ndarray) -> str:
         """Retrace / branch-jump guard on a converged increment ``du`` (``""`` if it is fine).
