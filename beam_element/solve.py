@@ -172,17 +172,20 @@ def _active_set_solution(
     )
 
 
-def _toward_target(model: BeamModel, probe: str, target: float) -> tuple[float, np.ndarray, int]:
+def _toward_target(
+    model: BeamModel, probe: str, target: float
+) -> tuple[float, np.ndarray, int, list[np.ndarray]]:
     """The sign of λ whose linear solution moves ``probe`` towards ``target``.
 
-    Returns (sign, the linear solution at λ = sign, active-set passes). Unilateral contact
-    makes the response homogeneous for λ > 0 only, so both signs are solved if need be.
+    Returns (sign, the linear solution at λ = sign, active-set passes, its active set).
+    Unilateral contact makes the response homogeneous for λ > 0 only, so both signs are solved
+    if need be.
     """
     row = model.probe_vector(probe)
     for sign in (1.0, -1.0):
-        u1, passes = linear_solution(model, sign)
+        u1, passes, active = _active_set_solution(model, sign)
         if float(row @ u1) * target > 0:
-            return sign, u1, passes
+            return sign, u1, passes, active
     raise ValueError(f"probe {probe!r} does not move under the scene's loads")
 
 
@@ -192,7 +195,7 @@ def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState
     probe = {n: model.probe_vector(n) for n in names}
     zero = ConvergedState(0, 0.0, np.zeros(model.size), 0, {n: 0.0 for n in names})
     if a.until_probe is not None:
-        sign, u1, passes = _toward_target(model, a.until_probe, a.until_value)
+        sign, u1, passes, _ = _toward_target(model, a.until_probe, a.until_value)
         λ = sign * a.until_value / float(probe[a.until_probe] @ u1)
         u = u1 * (λ / sign)
         message = f"linear solution scaled to {a.until_probe} = {a.until_value:g}"
@@ -567,9 +570,12 @@ def choose_core_levels(scene: object, elements: int | None, options: dict) -> Le
         return built[key]
 
     base = build(floor)
-    sign = _load_sign(base, scene)
+    sign, first = _load_sign(base, scene)
     settled: list[list[np.ndarray]] = []  # the last linear solve's active set
     solved: dict[int, np.ndarray] = {}
+    if first is not None:  # the floor at λ = sign, from every pair open: solved for the sign
+        solved[id(base)], active = first
+        settled.append(active)
 
     def solve_linear(model: BeamModel) -> np.ndarray:
         if id(model) not in solved:
@@ -599,17 +605,24 @@ def _local_zone_elements(scene: object, model: BeamModel) -> np.ndarray:
     return inside
 
 
-def _load_sign(model: BeamModel, scene: object) -> float:
-    """Sign of the load factor the analysis heads for (unilateral contact is not odd in λ)."""
+def _load_sign(
+    model: BeamModel, scene: object
+) -> tuple[float, tuple[np.ndarray, list[np.ndarray]] | None]:
+    """Sign of the load factor the analysis heads for (unilateral contact is not odd in λ).
+
+    Also returns the linear solution at λ = sign and its active set where finding the sign
+    solved it (an until probe), else None: the level choice's first solve is that one.
+    """
     a = scene.analysis
     if a.until_probe is not None:
         try:
-            return _toward_target(model, a.until_probe, a.until_value)[0]
+            sign, u1, _, active = _toward_target(model, a.until_probe, a.until_value)
+            return sign, (u1, active)
         except ValueError:  # the path follower says so in its own words
-            return 1.0
+            return 1.0, None
     if a.until_load_factor is not None and a.until_load_factor < 0:
-        return -1.0
-    return 1.0
+        return -1.0, None
+    return 1.0, None
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from beam_element.dofs import NODE_DOFS
 from beam_element.model import build_model
 from beam_element.shape_functions import x_shape, z_shape
 from beam_element.solve import linear_solution
-from sandwich.scene import Debond
+from sandwich.scene import Analysis, Debond
 
 
 def _hermite_cubic(xi: np.ndarray) -> np.ndarray:
@@ -227,3 +227,42 @@ def test_linear_active_set_from_another_start_ends_at_the_same_fixed_point():
         assert np.linalg.norm(u - u3) <= 1e-14 * np.linalg.norm(u3)
         assert passes < passes_3
     assert _active_set_solution(m3, 1.0, settled_1)[1] == 1
+
+
+def test_the_level_choice_solves_each_model_once(monkeypatch):
+    """Nothing computed twice: the floor's linear step that finds the load's sign (an until
+    probe) is the level choice's first solve, and each model of the choice is solved once —
+    and the choice is the one made with every solve done afresh (each from every pair open)."""
+    import importlib
+
+    from beam_element.solve import choose_core_levels, scene_model_options
+
+    solve_module = importlib.import_module("beam_element.solve")  # (the package's `solve` is
+    # the function of that name)
+
+    base = _debonded_bend()
+    scene = dataclasses.replace(base, beam_model=dataclasses.replace(
+        base.beam_model, core="auto", elements=24), analysis=Analysis(
+        kind="nonlinear", until_probe="w_top_mid", until_value=-4.0))
+    options = scene_model_options(scene)
+    real = solve_module._active_set_solution
+    seen: list[tuple[int, int]] = []
+
+    def counted(model, load_factor, start=None):
+        seen.append((id(model), model.size))
+        return real(model, load_factor, start)
+
+    monkeypatch.setattr(solve_module, "_active_set_solution", counted)
+    choice = choose_core_levels(scene, None, options)
+    assert len(seen) >= 3  # the floor, its look-ahead, at least one raise
+    assert len(set(seen)) == len(seen), seen
+
+    def afresh(model, load_factor, start=None):
+        return real(model, load_factor, None)
+
+    monkeypatch.setattr(solve_module, "_active_set_solution", afresh)
+    again = choose_core_levels(scene, None, options)
+    assert np.array_equal(choice.levels, again.levels)
+    assert np.any(choice.levels > 1)
+    assert [p["estimate"] for p in choice.passes] == pytest.approx(
+        [p["estimate"] for p in again.passes], rel=1e-9)
