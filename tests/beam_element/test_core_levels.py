@@ -8,6 +8,7 @@ differences of the internal force, and the nested-space identity of Galerkin sol
 from __future__ import annotations
 
 import dataclasses
+import sys
 
 import numpy as np
 import pytest
@@ -233,12 +234,9 @@ def test_the_level_choice_solves_each_model_once(monkeypatch):
     """Nothing computed twice: the floor's linear step that finds the load's sign (an until
     probe) is the level choice's first solve, and each model of the choice is solved once —
     and the choice is the one made with every solve done afresh (each from every pair open)."""
-    import importlib
-
     from beam_element.solve import choose_core_levels, scene_model_options
 
-    solve_module = importlib.import_module("beam_element.solve")  # (the package's `solve` is
-    # the function of that name)
+    solve_module = sys.modules["beam_element.solve"]  # the module (the package exports a function)
 
     base = _debonded_bend()
     scene = dataclasses.replace(base, beam_model=dataclasses.replace(
