@@ -477,10 +477,12 @@ def main():
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("--quick", action="store_true", help="60..480 elements, levels 1-2")
     p.add_argument("--no-2d", action="store_true", help="skip the 2D runs of fig. 5")
-    p.add_argument("--iterations-only", action="store_true",
-                   help="only the Newton iteration table (newton_iteration.md), not fig. 5's runs")
-    p.add_argument("--fig5-only", action="store_true",
-                   help="only fig. 5's runs (fig5_speed.md), not the Newton iteration table")
+    only = p.add_mutually_exclusive_group()
+    only.add_argument("--iterations-only", action="store_true",
+                      help="only the Newton iteration table (newton_iteration.md), not fig. 5's "
+                      "runs")
+    only.add_argument("--fig5-only", action="store_true",
+                      help="only fig. 5's runs (fig5_speed.md), not the Newton iteration table")
     p.add_argument("--convergence", action="store_true",
                    help="also the fig. 5 λ(−15) convergence table (120 … 1920 elements)")
     args = p.parse_args()
