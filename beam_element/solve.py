@@ -7,8 +7,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -206,6 +207,44 @@ def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState
     state = ConvergedState(1, float(λ), u, passes, {n: float(probe[n] @ u) for n in names})
     model.commit(u, λ)
     return [zero, state], message
+
+
+def linear_responses(scene: Scene, cores: Sequence[int]) -> list[float]:
+    """The linear step's response at each uniform core level of ``cores``, in that order.
+
+    The model is the one :func:`run` builds for ``scene`` with ``[beam_model] core`` set to the
+    level (its ``core_zones`` kept). The response is the until probe's value c·u at the unit load
+    factor that moves it towards its target (the linear stiffness, as :func:`_linear_states`
+    scales it), else the compliance fᵀu at λ = ±1 (the sign of ``until_load_factor``). Each
+    unilateral active-set solve starts from the set the one before settled on: the iteration
+    has one fixed point (:func:`_active_set_solution`), so each level's set is the one it finds
+    from every pair open — fig. 5's knock-down cases at level 3: 1-3 passes instead of 7-14 —
+    and its solution the same to round-off (the envelope's order depends on the first
+    matrix a model factorises).
+    """
+    a = scene.analysis
+    options = scene_model_options(scene)
+    out: list[float] = []
+    settled = None
+    for core in cores:
+        s = dataclasses.replace(scene, beam_model=dataclasses.replace(scene.beam_model,
+                                                                      core=int(core)))
+        levels = choose_core_levels(s, None, options).levels
+        model = build_model(s, gauss=_gauss_orders(s), **{**options, "core_level": levels})
+        if a.until_probe is not None:
+            row, signs = model.probe_vector(a.until_probe), (1.0, -1.0)
+        else:
+            negative = a.until_load_factor is not None and a.until_load_factor < 0
+            row, signs = model.f_ref, ((-1.0,) if negative else (1.0,))
+        for sign in signs:
+            u1, _, settled = _active_set_solution(model, sign, settled)
+            value = float(row @ u1)
+            if a.until_probe is None or value * a.until_value > 0:
+                break
+        else:
+            raise ValueError(f"probe {a.until_probe!r} does not move under the scene's loads")
+        out.append(value)
+    return out
 
 
 def _min_increment(model: BeamModel, analysis: object) -> float | None:

@@ -10,7 +10,6 @@ raises for a case's failure: a failing case is a record with its reason.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import os
@@ -21,7 +20,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from models import PROJECT_ROOT, get_model, obtain, stored_identity, with_options
+from models import PROJECT_ROOT, get_model, obtain, stored_identity
 from sandwich.quiet_logs import hush_libraries
 from sandwich.results import load_result
 from sandwich.scene import MAX_CORE_LEVEL, Scene
@@ -81,19 +80,19 @@ def linear_indicator(scene: Scene) -> float | None:
 
     The relative change of the linear stiffness when every core level is raised by
     :data:`LOOKAHEAD` (the saturation estimate the ``"auto"`` core uses,
-    :mod:`beam_element.core_levels`), on the small-displacement step.
+    :mod:`beam_element.core_levels`), on the small-displacement step: of the until probe's
+    response, else of the compliance (:func:`beam_element.solve.linear_responses`; the two
+    solves, the second started from the first one's contact set, are all it computes).
     """
+    from beam_element.solve import linear_responses  # (the beam's kernels: when needed)
+
     level = scene.beam_model.core
     if not isinstance(level, int):
         return None
-    linear = dataclasses.replace(scene, analysis=dataclasses.replace(scene.analysis,
-                                                                     kind="linear"))
-    spec = get_model("beam")
-    lo = spec.solve(linear)
-    hi = spec.solve(with_options(linear, "beam", core=min(level + LOOKAHEAD, MAX_CORE_LEVEL)))
-    if not (lo.history and hi.history) or hi.final_load_factor == 0.0:
+    lo, hi = linear_responses(scene, (level, min(level + LOOKAHEAD, MAX_CORE_LEVEL)))
+    if lo == 0.0:
         return None
-    err = abs(lo.final_load_factor - hi.final_load_factor) / abs(hi.final_load_factor)
+    err = abs(hi - lo) / abs(lo)
     return err if math.isfinite(err) else None
 
 

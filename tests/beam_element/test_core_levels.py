@@ -264,3 +264,60 @@ def test_the_level_choice_solves_each_model_once(monkeypatch):
     assert np.any(choice.levels > 1)
     assert [p["estimate"] for p in choice.passes] == pytest.approx(
         [p["estimate"] for p in again.passes], rel=1e-9)
+
+
+def _linear_run(scene, core):
+    """The linear step as the runner solves it: ``run`` with ``[beam_model] core = core``."""
+    from beam_element import run
+
+    s = dataclasses.replace(scene, beam_model=dataclasses.replace(scene.beam_model, core=core),
+                            analysis=dataclasses.replace(scene.analysis, kind="linear"))
+    return run(s)
+
+
+def test_linear_responses_are_the_runs_linear_steps_with_fewer_passes(monkeypatch):
+    """``linear_responses`` (the study's error indicator) against the runner's own linear step
+    at each level (reference: ``run``, each solve from every pair open): the probe's value at
+    unit load is until / λ of the run, to round-off; the second level's active-set solve starts
+    from the first level's set and takes fewer passes than from every pair open."""
+    from beam_element.solve import linear_responses
+
+    solve_module = sys.modules["beam_element.solve"]
+    scene = dataclasses.replace(_debonded_bend(), beam_model=dataclasses.replace(
+        _debonded_bend().beam_model, elements=24), analysis=Analysis(
+        kind="nonlinear", until_probe="w_top_mid", until_value=-4.0))
+    real = solve_module._active_set_solution
+    passes = []
+
+    def counted(model, load_factor, start=None):
+        out = real(model, load_factor, start)
+        passes.append((model.size, start is not None, out[1]))
+        return out
+
+    monkeypatch.setattr(solve_module, "_active_set_solution", counted)
+    lo, hi = linear_responses(scene, (1, 3))
+    seeded = passes[-1]
+    passes.clear()
+    for core, r in ((1, lo), (3, hi)):
+        sol = _linear_run(scene, core).solution
+        assert -4.0 / sol.history[-1].load_factor == pytest.approx(r, rel=1e-12)
+    afresh = passes[-1]
+    assert seeded[0] == afresh[0] and seeded[1] and not afresh[1]
+    assert afresh[2] >= 3 and seeded[2] < afresh[2], (seeded, afresh)
+    assert abs(hi / lo - 1) > 1e-3  # level 3 is another answer (the comparison has content)
+
+
+def test_linear_responses_without_a_probe_are_compliances():
+    """A load target: the response is the compliance fᵀu at λ = 1, against the runner's linear
+    step at λ = until_load_factor (fᵀu / λ; homogeneous in λ > 0 with unilateral contact)."""
+    from beam_element.solve import linear_responses
+
+    scene = dataclasses.replace(_debonded_bend(), beam_model=dataclasses.replace(
+        _debonded_bend().beam_model, elements=24), analysis=Analysis(
+        kind="nonlinear", control="load", until_load_factor=50.0))
+    got = linear_responses(scene, (1, 2))
+    for core, r in zip((1, 2), got, strict=True):
+        run = _linear_run(scene, core)
+        u = run.states[-1].u
+        assert float(run.model.f_ref @ u) / 50.0 == pytest.approx(r, rel=1e-10)
+    assert got[0] > 0 and abs(got[1] / got[0] - 1) > 1e-3

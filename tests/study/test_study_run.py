@@ -178,3 +178,29 @@ def test_a_case_over_the_wall_time_cap_keeps_its_converged_steps(tmp_path, monke
     states = (folder / "history.csv").read_text().splitlines()[1:]
     assert 3 <= len(states) <= 8  # about 1 s / 0.2 s of converged steps, then stopped
     assert by_x[140.0]["status"] == "done"
+
+
+def test_the_indicator_of_a_load_controlled_case_is_its_compliance_change():
+    """A case with a load target (no until probe): the indicator is the relative change of the
+    compliance fᵀu when the core levels are raised (reference: the runner's own linear steps at
+    both levels, fᵀu / λ each). It was 0 for every such case: it compared the two runs' end load
+    factors, which a load target fixes."""
+    import dataclasses
+
+    from beam_element import run
+    from sandwich.scene import Analysis
+    from sandwich.scene_file import load_scene
+
+    base = load_scene(HERE.parents[1] / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
+    scene = dataclasses.replace(
+        base, beam_model=dataclasses.replace(base.beam_model, core=1, elements=60),
+        analysis=Analysis(kind="nonlinear", control="load", until_load_factor=300.0))
+    compliance = []
+    for core in (1, 1 + study_case.LOOKAHEAD):
+        r = run(dataclasses.replace(
+            scene, beam_model=dataclasses.replace(scene.beam_model, core=core),
+            analysis=dataclasses.replace(scene.analysis, kind="linear")))
+        compliance.append(float(r.model.f_ref @ r.states[-1].u) / 300.0)
+    expected = abs(compliance[1] - compliance[0]) / abs(compliance[0])
+    assert expected > 1e-3
+    assert study_case.linear_indicator(scene) == pytest.approx(expected, rel=1e-9)
