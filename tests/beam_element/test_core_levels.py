@@ -12,6 +12,7 @@ import sys
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from beam_scenes import sandwich_scene as three_point_bend
 
 from beam_element.core_basis import MAX_LEVEL, CoreBasis
@@ -321,3 +322,27 @@ def test_linear_responses_without_a_probe_are_compliances():
         u = run.states[-1].u
         assert float(run.model.f_ref @ u) / 50.0 == pytest.approx(r, rel=1e-10)
     assert got[0] > 0 and abs(got[1] / got[0] - 1) > 1e-3
+
+
+def test_linear_contact_added_on_the_tangents_pattern_is_scipys_sum():
+    """The active-set passes add the linearised contact at its slots of K₀'s pattern instead of
+    forming scipy's sum (whose pattern drops K₀'s explicit zeros) and embedding it back: every
+    entry the same bits as the sum's, and None for an entry outside the pattern."""
+    from beam_element.solve import _linear_contact_matrix, _pattern_keys, _plus_on_pattern
+
+    model = build_model(_debonded_bend(), elements=24, core_level=2)
+    K0 = model.tangent(np.zeros(model.size))
+    keys = _pattern_keys(model, K0)
+    assert keys is not None and np.all(np.diff(keys) > 0)
+    rng = np.random.default_rng(3)
+    active = [rng.random(p.size) < 0.5 for p in model.pairs]
+    C = _linear_contact_matrix(model, active)
+    assert C.nnz > 0
+    got, want = _plus_on_pattern(K0, C, keys), (K0 + C).tocsr()
+    assert got.indices is K0.indices or np.array_equal(got.indices, K0.indices)
+    diff = got - want
+    assert diff.count_nonzero() == 0  # the same bits where the sum has entries, zeros elsewhere
+    assert np.array_equal(got.toarray(), want.toarray())
+    far = sp.csr_matrix(([1.0], ([0], [model.size - 1])), shape=K0.shape)  # no such coupling
+    assert _plus_on_pattern(K0, far, keys) is None
+    assert _pattern_keys(model, want) is None  # the sum is not on the pattern
