@@ -258,9 +258,9 @@ def linear_responses(scene: Scene, cores: Sequence[int]) -> list[float]:
     scales it), else the compliance fᵀu at λ = ±1 (the sign of ``until_load_factor``). Each
     unilateral active-set solve starts from the set the one before settled on: the iteration
     has one fixed point (:func:`_active_set_solution`), so each level's set is the one it finds
-    from every pair open — fig. 5's knock-down cases at level 3: 1-3 passes instead of 7-14 —
-    and its solution the same to round-off (the envelope's order depends on the first
-    matrix a model factorises).
+    from every pair open — knock-down cases of fig. 5 at level 3: 7, 6 and 4 passes instead of
+    7, 14 and 18 — and its solution the same to round-off (the envelope's order depends on the
+    first matrix a model factorises).
     """
     a = scene.analysis
     options = scene_model_options(scene)
