@@ -87,9 +87,10 @@ def linear_indicator(scene: Scene) -> float | None:
     from beam_element.solve import linear_responses  # (the beam's kernels: when needed)
 
     level = scene.beam_model.core
-    if not isinstance(level, int):
+    raised = min(level + LOOKAHEAD, MAX_CORE_LEVEL) if isinstance(level, int) else None
+    if raised is None or raised == level:  # "auto", or no level above to compare with
         return None
-    lo, hi = linear_responses(scene, (level, min(level + LOOKAHEAD, MAX_CORE_LEVEL)))
+    lo, hi = linear_responses(scene, (level, raised))
     if lo == 0.0:
         return None
     err = abs(hi - lo) / abs(lo)

@@ -204,3 +204,20 @@ def test_the_indicator_of_a_load_controlled_case_is_its_compliance_change():
     expected = abs(compliance[1] - compliance[0]) / abs(compliance[0])
     assert expected > 1e-3
     assert study_case.linear_indicator(scene) == pytest.approx(expected, rel=1e-9)
+
+
+def test_no_indicator_at_the_top_core_level():
+    """At the highest core level there is no level above to compare with: the indicator is
+    unknown (None), not 0 (the change from a level to itself)."""
+    import dataclasses
+
+    from sandwich.scene import MAX_CORE_LEVEL
+    from sandwich.scene_file import load_scene
+
+    base = load_scene(HERE.parents[1] / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
+    top = dataclasses.replace(base, beam_model=dataclasses.replace(
+        base.beam_model, core=MAX_CORE_LEVEL, elements=12))
+    assert study_case.linear_indicator(top) is None
+    below = dataclasses.replace(top, beam_model=dataclasses.replace(
+        top.beam_model, core=MAX_CORE_LEVEL - 1))
+    assert study_case.linear_indicator(below) > 0  # one level above it still: measured
