@@ -134,8 +134,8 @@ def _linear_contact_matrix(model: BeamModel, active: list[np.ndarray]) -> sp.csr
 def _pattern_keys(model: BeamModel, K: sp.csr_matrix) -> np.ndarray | None:
     """Row · n + column of each entry of ``K`` (increasing), if ``K`` is on the model's pattern.
 
-    The tangent at u = 0 is (:meth:`~beam_element.model.BeamModel.tangent`: the reduced
-    pattern, its explicit zeros included). None otherwise.
+    :meth:`~beam_element.model.BeamModel.tangent` returns its matrices on that pattern, explicit
+    zeros included. None for any other pattern.
     """
     p = model.pattern
     if (K.shape != (p.n, p.n) or K.indices.size != p.indices.size
@@ -160,8 +160,7 @@ def _plus_on_pattern(K0: sp.csr_matrix, C: sp.csr_matrix, keys: np.ndarray
     n = K0.shape[0]
     wanted = np.repeat(np.arange(n, dtype=np.int64), np.diff(C.indptr)) * n + C.indices
     slots = np.searchsorted(keys, wanted)
-    if np.any(slots >= keys.size) or not np.array_equal(keys[np.minimum(slots, keys.size - 1)],
-                                                         wanted):
+    if np.any(slots >= keys.size) or not np.array_equal(keys[slots], wanted):
         return None
     data = K0.data.copy()
     data[slots] += C.data  # (canonical C: each slot once)
