@@ -37,6 +37,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from installed import write_bytecode  # noqa: E402  (benchmarks/, the script's folder)
+
 from beam_element import build_model, kernels, run  # noqa: E402
 from beam_element.core_levels import transfer  # noqa: E402
 from beam_element.model import BeamModel  # noqa: E402
@@ -254,6 +256,7 @@ def paired_ratios(n: int) -> list[dict[str, float]]:
 
 
 def fig5_speed(repeat, with_2d):
+    write_bytecode()  # the CLI runs start from the installed state (benchmarks/installed.py)
     before = load()
     t_new, s_new = in_process_path(False, repeat)
     t_ref, s_ref = in_process_path(True, repeat)

@@ -33,6 +33,8 @@ import time
 import tomllib
 from pathlib import Path
 
+from installed import write_bytecode  # benchmarks/, the script's folder
+
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"
 OUT = ROOT / "benchmarks" / "results" / "beam"
@@ -86,6 +88,7 @@ def main() -> None:
     p.add_argument("--out", default="scene_speed", help="output stem under benchmarks/results/beam")
     args = p.parse_args()
     names = args.scenes or sorted(f.stem for f in SCENES.glob("*.toml"))
+    write_bytecode()  # the runs start from the installed state (benchmarks/installed.py)
     rows = []
     for name in names:
         scene = SCENES / f"{name}.toml"
