@@ -154,6 +154,11 @@ class PathOptions:
         If the crossed target cannot be hit within ``target_tol`` (corrector failures on the
         shortened steps), the closest state is still accepted as reaching the target when it
         misses by at most this (relative); the message says by how much.
+    stop_at_load_reversal
+        Stop (not reached) at the first converged state whose λ has the other sign than the
+        state before's: the path has come back through the unloaded state. Off by default (a
+        snap-through may cross λ = 0 and come back); the beam's ``auto`` core levels set it on
+        its reruns, which check a pass that never crossed it (docs/solver.md).
     """
 
     control: str = "load"
@@ -176,6 +181,7 @@ class PathOptions:
     probe_rescue: bool = True
     target_tol: float = 1e-6
     target_accept: float = 1e-3
+    stop_at_load_reversal: bool = False
 
     @classmethod
     def from_analysis(cls, analysis: object, **overrides: object) -> PathOptions:
@@ -370,9 +376,11 @@ class _Follower:
     def finish(self, reached: bool, message: str) -> PathResult:
         opt = self.opt
         if (opt.until_probe is not None and opt.until_load_factor is None and self.states
-                and self.states[-1].load_factor < 0):
+                and self.states[-1].load_factor < 0
+                and not any(s.load_factor > 0 for s in self.states)):
             # The probe's target lies the other way from where the loads push it: the follower
             # heads for it with λ < 0, which a user rarely means (a sign slip in until or force).
+            # (Not said of a path that came back through zero load: no sign slip sends it there.)
             message += (f"; WARNING: {opt.until_probe} heads for {opt.until_value:g} only "
                         "with λ < 0: every load's force is reversed (check the sign of "
                         "analysis.until's value and of the loads' force)")
@@ -450,6 +458,10 @@ class _Follower:
             fac = trial.factorization
             yield self.accept(trial.u, trial.load_factor, trial.iterations, fac.negative_pivots,
                               cuts)
+            if opt.stop_at_load_reversal and trial.load_factor * last.load_factor < 0:
+                return self.finish(False, (
+                    f"step {step}: the path came back through zero load (λ {last.load_factor:.6g}"
+                    f" → {trial.load_factor:.6g}); stopped there (stop_at_load_reversal)"))
             try:
                 t = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded

@@ -157,3 +157,25 @@ def test_shipped_scene_reaches_its_until_with_auto_levels(path):
     assert sol.extra["core"]["how"] == "auto"
     assert np.isfinite(sol.extra["core"]["estimated_error"])
     assert sol.extra["max_penetration"] <= r.model.penetration_bound()
+
+
+def test_auto_reruns_stop_where_the_path_comes_back_through_zero_load(monkeypatch):
+    """A rerun (a capped pass checking a lower-level one) follows with stop_at_load_reversal on,
+    a first pass without (fig. 5's scene with a 45-mm debond at x = 70: a level-3 rerun went on
+    to λ = −2447 for 156 steps before; docs/solver.md)."""
+    import sandwich.solver.path as path_module
+
+    seen = []
+    real = path_module.follow_path
+
+    def spy(system, options, *args, **kwargs):
+        seen.append(options.stop_at_load_reversal)
+        return real(system, options, *args, **kwargs)
+
+    monkeypatch.setattr(path_module, "follow_path", spy)
+    solve = sys.modules["beam_element.solve"]
+    scene = _bend_to_6mm()
+    model = build_model(scene, core_level=1)
+    solve._follow(model, scene, None)
+    solve._follow(model, scene, None, max_steps=3)
+    assert seen == [False, True]
