@@ -218,17 +218,17 @@ def _active_set_solution(
 
 
 def _toward_target(
-    model: BeamModel, probe: str, target: float
+    model: BeamModel, probe: str, target: float, start: list[np.ndarray] | None = None
 ) -> tuple[float, np.ndarray, int, list[np.ndarray]]:
     """The sign of λ whose linear solution moves ``probe`` towards ``target``.
 
     Returns (sign, the linear solution at λ = sign, active-set passes, its active set).
     Unilateral contact makes the response homogeneous for λ > 0 only, so both signs are solved
-    if need be.
+    if need be, each from the active set ``start`` (:func:`_active_set_solution`).
     """
     row = model.probe_vector(probe)
     for sign in (1.0, -1.0):
-        u1, passes, active = _active_set_solution(model, sign)
+        u1, passes, active = _active_set_solution(model, sign, start)
         if float(row @ u1) * target > 0:
             return sign, u1, passes, active
     raise ValueError(f"probe {probe!r} does not move under the scene's loads")
@@ -276,18 +276,12 @@ def linear_responses(scene: Scene, cores: Sequence[int]) -> list[float]:
         levels = choose_core_levels(s, None, options).levels
         model = build_model(s, gauss=_gauss_orders(s), **{**options, "core_level": levels})
         if a.until_probe is not None:
-            row, signs = model.probe_vector(a.until_probe), (1.0, -1.0)
+            _, u1, _, settled = _toward_target(model, a.until_probe, a.until_value, settled)
+            out.append(float(model.probe_vector(a.until_probe) @ u1))
         else:
-            negative = a.until_load_factor is not None and a.until_load_factor < 0
-            row, signs = model.f_ref, ((-1.0,) if negative else (1.0,))
-        for sign in signs:
+            sign = -1.0 if a.until_load_factor is not None and a.until_load_factor < 0 else 1.0
             u1, _, settled = _active_set_solution(model, sign, settled)
-            value = float(row @ u1)
-            if a.until_probe is None or value * a.until_value > 0:
-                break
-        else:
-            raise ValueError(f"probe {a.until_probe!r} does not move under the scene's loads")
-        out.append(value)
+            out.append(float(model.f_ref @ u1))
     return out
 
 
