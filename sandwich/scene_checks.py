@@ -123,6 +123,14 @@ class Reader:
             return None
         return v
 
+    def boolean(self, tbl: dict[str, Any], k: str, key: str, *, default: bool) -> bool:
+        """Read true or false."""
+        v = tbl.get(k, default)
+        if not isinstance(v, bool):
+            self.fail(_join(key, k), f"expected true or false, got {_typename(v)}")
+            return default
+        return v
+
     def choice(self, tbl: dict[str, Any], k: str, key: str, options: tuple[str, ...], *,
                default: Any = _MISSING) -> Any:
         """Read a string that must be one of ``options``."""
@@ -423,7 +431,8 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
 def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     key = "analysis"
     t = r.table(tbl, key, ("kind", "control", "until", "max_steps", "initial_increment",
-                           "min_increment", "max_increment", "tol", "max_iterations"),
+                           "min_increment", "max_increment", "tol", "max_iterations",
+                           "locate_bifurcations"),
                 required=("kind", "until"))
     if t is None:
         return Analysis()
@@ -472,7 +481,9 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     return Analysis(kind=kind or d.kind, control=control or d.control, until_probe=until_probe,
                     until_value=until_value, until_load_factor=until_lf,
                     max_steps=max_steps or d.max_steps, initial_increment=inc, min_increment=lo,
-                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations)
+                    max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations,
+                    locate_bifurcations=r.boolean(t, "locate_bifurcations", key,
+                                                  default=d.locate_bifurcations))
 
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
@@ -547,10 +558,7 @@ def _reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
              for k in ("core_size", "face_size", "tip_size")}
     if level == "explicit" and sizes["core_size"] is None:
         r.fail("reference2d.core_size", "level 'explicit' needs core_size (mm)")
-    half = t.get("half_model", False)
-    if not isinstance(half, bool):
-        r.fail("reference2d.half_model", f"expected true or false, got {_typename(half)}")
-        half = False
+    half = r.boolean(t, "half_model", key, default=False)
     return Reference2DOptions(
         level=level or d.level,
         refine=r.integer(t, "refine", key, default=d.refine, lo=0, hi=6) or 0,

@@ -28,7 +28,7 @@ from studies.study_params import DERIVED, DERIVED_KEYS, PathError, base_value, r
 
 MODELS = ("beam", "2d")
 TOP_KEYS = ("name", "description", "scene", "model", "check", "timeout", "max_cells", "fields",
-            "axis", "beam_model", "reference2d", "report")
+            "axis", "analysis", "beam_model", "reference2d", "report")
 AXIS_KEYS = ("name", "path", "derived", "values", "range", "logrange", "scale", "debond",
              "centre", "interfaces")
 REPORT_KEYS = ("quantity", "reference", "threshold")
@@ -328,8 +328,8 @@ def load_study(path: str | Path) -> Study:
     """Read, check and expand the study in ``path``; raise :class:`StudyError` if it is bad.
 
     The base scene is read like any scene file; each case's scene is built from its data with
-    the axes applied and the study's ``[beam_model]`` / ``[reference2d]`` merged into the
-    scene's tables, then checked by the scene checks.
+    the axes applied and the study's ``[analysis]`` / ``[beam_model]`` / ``[reference2d]``
+    merged into the scene's tables, then checked by the scene checks.
     """
     path = Path(path)
     fname = str(path)
@@ -373,7 +373,7 @@ def load_study(path: str | Path) -> Study:
     if check and model != "beam":
         p.fail("check", "2D spot checks are of a beam study (model = \"beam\")")
     tables = {}
-    for t in ("beam_model", "reference2d"):
+    for t in ("analysis", "beam_model", "reference2d"):
         v = data.get(t, {})
         if not isinstance(v, dict):
             p.fail(t, "expected a table")

@@ -124,7 +124,9 @@ def load_result(folder: str | Path, *, fields: bool = True) -> Solution:
         LimitPoint(kind=lp["kind"], step=int(lp["step"]), load_factor=_float(lp["load_factor"]),
                    probes={k: _float(v) for k, v in lp.get("probes", {}).items()},
                    between=(tuple(_float(v) for v in lp["between_load_factors"])
-                            if "between_load_factors" in lp else None))
+                            if "between_load_factors" in lp else None),
+                   located_at=(_float(lp["located_at_step_fraction"])
+                               if "located_at_step_fraction" in lp else None))
         for lp in summary.get("limit_points", [])
     ]
     return Solution(

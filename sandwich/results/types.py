@@ -49,6 +49,10 @@ class LimitPoint:
     # bifurcation lies between the state before ``step`` and ``step``, an extremum between the
     # states either side of ``step``; the point is known to that resolution only
     between: tuple[float, float] | None = None
+    # a bifurcation located within its step (:mod:`sandwich.solver.critical`): the fraction of
+    # the step from the state before at which the tangent's crossed eigenvalue is zero, where
+    # ``load_factor`` and ``probes`` are interpolated; None: reported at the state ``step``
+    located_at: float | None = None
 
 
 @dataclass

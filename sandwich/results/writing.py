@@ -7,8 +7,9 @@ A solve writes, as one set (:func:`write_solution`), into its folder:
 - ``profiles.csv``: ``step, x, w_top, w_bottom, sigma_zz_top, sigma_zz_bottom, tau_core[, more]``
   (interface normal stress at the core's top and bottom boundary, core shear at mid-core, MPa);
 - ``summary.json``: ``model, scene, converged, steps, final_load_factor, limit_points``
-  (``kind, step, load_factor, probes``, and ``between_load_factors``: the states that enclose
-  the point), ``wall_seconds, dofs`` and more;
+  (``kind, step, load_factor, probes``, ``between_load_factors``: the states that enclose
+  the point, and for a bifurcation located within its step ``located_at_step_fraction``),
+  ``wall_seconds, dofs`` and more;
 - ``fields.pvd`` + ``fields_NNNNN.vtu`` when the model returns 2D field frames (ParaView);
 - ``tip_tractions.csv`` when the scene (given) has debond tips: σzz and τ of the interface
   around each tip at every profile step (:mod:`sandwich.results.tractions`).
@@ -125,7 +126,9 @@ def summary_dict(solution: Solution) -> dict[str, object]:
             {"kind": lp.kind, "step": lp.step, "load_factor": _finite(lp.load_factor),
              "probes": {k: _finite(v) for k, v in lp.probes.items()},
              **({"between_load_factors": [_finite(v) for v in lp.between]}
-                if lp.between is not None else {})}
+                if lp.between is not None else {}),
+             **({"located_at_step_fraction": _finite(lp.located_at)}
+                if lp.located_at is not None else {})}
             for lp in solution.limit_points
         ],
         "wall_seconds": _finite(solution.wall_seconds),

@@ -6,11 +6,17 @@
 - A *bifurcation* is a change of the tangent's negative-pivot count between two successive states
   that is not explained by a limit point: a simple limit point changes the count by one between
   the state before and the state after it; any further change (or a change with no limit point
-  next to it) is reported at the first state with the new count.
+  next to it) is a bifurcation on that step (located within it, below).
 
 Each point carries ``between``: the load factors of the two converged states that enclose it
 along the path (the states either side of an extremum; the state before a bifurcation and the
-one reported), so a user sees to what resolution the path located it.
+one reported), so a user sees to what resolution the path sampled it. A bifurcation whose state
+carries a ``crossing`` (located within its step by the path follower:
+:meth:`sandwich.solver.path._Follower._locate_crossing`) is reported there instead: its load
+factor and probes are the located point's, ``between`` the bracket it was located in (the
+step's states, or equilibria solved inside the step), ``located_at`` its fraction of the step.
+Without one (a change of the count shared with a limit point, a location that failed, states
+from elsewhere) it is reported at the first state with the new count.
 """
 
 from __future__ import annotations
@@ -63,7 +69,13 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
                 change -= 1
         if change:
             s = states[k]
-            found.append(LimitPoint("bifurcation", s.step, float(s.load_factor), dict(s.probes),
-                                    (float(lam[k - 1]), float(lam[k]))))
+            c = getattr(s, "crossing", None)
+            if c is not None and change == abs(b - a):  # located, no limit point shares it
+                found.append(LimitPoint("bifurcation", s.step, float(c.load_factor),
+                                        dict(c.probes), tuple(map(float, c.between)),
+                                        float(c.fraction)))
+            else:
+                found.append(LimitPoint("bifurcation", s.step, float(s.load_factor),
+                                        dict(s.probes), (float(lam[k - 1]), float(lam[k]))))
     found.sort(key=lambda lp: lp.step)
     return found

@@ -57,6 +57,18 @@ import numpy as np
 
 from sandwich.results import LimitPoint
 from sandwich.solver.controls import ArcLengthConstraint, LoadConstraint, ProbeConstraint
+from sandwich.solver.critical import (
+    LOCATE_RTOL,
+    MAX_CROSSINGS,
+    MAX_SUBSTEPS,
+    BracketEnd,
+    Crossing,
+    crossed_eigenvalue,
+    crossing_in,
+    halved,
+    locate_crossing,
+    next_fraction,
+)
 from sandwich.solver.limits import find_limit_points
 from sandwich.solver.newton import (
     RECOVERABLE_ERRORS,
@@ -159,6 +171,15 @@ class PathOptions:
         state before's: the path has come back through the unloaded state. Off by default (a
         snap-through may cross λ = 0 and come back); the beam's ``auto`` core levels set it on
         its reruns, which check a pass that never crossed it (docs/solver.md).
+    locate_bifurcations
+        Narrow a step across a bifurcation by equilibria solved inside it: shorter steps from
+        the state before (the path's own predictor and corrector, up to
+        :data:`~sandwich.solver.critical.MAX_SUBSTEPS`), aimed where the crossed eigenvalue is
+        interpolated to be zero, until the located load moves by less than
+        :data:`~sandwich.solver.critical.LOCATE_RTOL`. They are not path states (the path is
+        the same with or without). Off by default: a bifurcation is then located within its
+        step from the eigenvalue at the step's two states (no corrector, second order in the
+        step; :meth:`_Follower._locate_crossing`).
     """
 
     control: str = "load"
@@ -182,6 +203,7 @@ class PathOptions:
     target_tol: float = 1e-6
     target_accept: float = 1e-3
     stop_at_load_reversal: bool = False
+    locate_bifurcations: bool = False
 
     @classmethod
     def from_analysis(cls, analysis: object, **overrides: object) -> PathOptions:
@@ -191,7 +213,8 @@ class PathOptions:
         increment floor, ``desired_iterations``); ``None`` values among them are kept.
         """
         names = ("control", "until_load_factor", "until_probe", "until_value", "max_steps",
-                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations")
+                 "initial_increment", "min_increment", "max_increment", "tol", "max_iterations",
+                 "locate_bifurcations")
         return cls(**{**{n: getattr(analysis, n) for n in names}, **overrides})
 
     def __post_init__(self) -> None:
@@ -230,6 +253,10 @@ class PathState:
     probes: dict[str, float]
     negative_pivots: int | None
     cuts: int = 0
+    # where the tangent's inertia changed on the step that ends here: the bifurcation located
+    # within the step (:meth:`_Follower._locate_crossing`), None if it did not change or could
+    # not be located
+    crossing: Crossing | None = None
     # per-state history columns the model adds (``system.state_columns(u)``, optional): kept on
     # the state so that an interrupted run still writes them (e.g. G at the debond tips)
     extra: dict[str, float | None] = field(default_factory=dict)
@@ -455,17 +482,21 @@ class _Follower:
                 dv = self._value(opt.until_probe, trial.u, 0.0) - last.probes[opt.until_probe]
                 self.recent = [*self.recent, (h_try, dv)][-RESCUE_MEMORY:]
                 self.peak = max(self.peak, h_try)
-            fac = trial.factorization
-            yield self.accept(trial.u, trial.load_factor, trial.iterations, fac.negative_pivots,
-                              cuts)
+            fac_before, fac = fac, trial.factorization
+            state = self.accept(trial.u, trial.load_factor, trial.iterations,
+                                fac.negative_pivots, cuts)
+            yield state
             if opt.stop_at_load_reversal and trial.load_factor * last.load_factor < 0:
                 return self.finish(False, (
                     f"step {step}: the path came back through zero load (λ {last.load_factor:.6g}"
                     f" → {trial.load_factor:.6g}); stopped there (stop_at_load_reversal)"))
             try:
-                t = np.asarray(fac.solve(self.f_ref), dtype=float)
+                t_next = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
+            regular = not (direct or crossed or step in self.rescues)
+            self._locate_crossing(state, last, fac_before, fac, t, h_try if regular else None)
+            t = t_next
             done = self._target_reached()
             if done:
                 return self.finish(True, done)
@@ -582,6 +613,67 @@ class _Follower:
                 or self._crossings(last, trial)):
             return None
         return trial
+
+    def _locate_crossing(self, state: PathState, last: PathState, fac_before: object,
+                         fac: object, t: np.ndarray, h: float | None) -> None:
+        """Locate a bifurcation within the step ``last`` → ``state`` (their inertia differs).
+
+        First from the two factorisations the step has
+        (:func:`~sandwich.solver.critical.locate_crossing`: solves only, no tangent evaluated):
+        where the crossed eigenvalue, linear along the step, is zero. Then, with
+        ``locate_bifurcations`` and a regular step of size ``h`` from ``last`` (``t`` its load
+        tangent; None: a target's or a rescue's; for a kept bent step, the increment to it),
+        shorter steps from ``last``
+        aimed at that point narrow the bracket (regula falsi on the eigenvalue, Illinois'
+        rule); their equilibria are not path states, and the path's own settings
+        (contact-limited corrections) are left as they were.
+        """
+        a, b = last.negative_pivots, state.negative_pivots
+        if a is None or b is None or a == b:
+            return
+        try:
+            c = locate_crossing(fac_before, fac, b - a, self.system.size, self.dot,
+                                state.u - last.u)
+        except RECOVERABLE_ERRORS:  # a solve that fails: reported at the state, as before
+            c = None
+        lo = BracketEnd(0.0, last.load_factor, dict(last.probes), a,
+                        None if c is None else c.mu_before)
+        hi = BracketEnd(1.0, state.load_factor, dict(state.probes), b,
+                        None if c is None else c.mu_after)
+        found = None if c is None else crossing_in(lo, hi, 0)
+        if not self.opt.locate_bifurcations or h is None or abs(b - a) > MAX_CROSSINGS:
+            state.crossing = found
+            return
+        old_sign = 1.0 if b > a else -1.0
+        replaced: list[str] = []
+        for _ in range(MAX_SUBSTEPS):
+            if abs(hi.load_factor - lo.load_factor) <= LOCATE_RTOL * max(
+                    abs(lo.load_factor), abs(hi.load_factor)):
+                break
+            f = next_fraction(halved(lo) if replaced[-2:] == ["hi", "hi"] else lo,
+                              halved(hi) if replaced[-2:] == ["lo", "lo"] else hi)
+            failed_once = self.failed_once  # a failed try does not change the path's settings
+            try:
+                trial, _ = self._attempt(f * h, last, t)
+            except RECOVERABLE_ERRORS:
+                trial = None
+            self.failed_once = failed_once
+            n = None if trial is None else trial.factorization.negative_pivots
+            if n is None:
+                break
+            try:
+                mu = crossed_eigenvalue(trial.factorization, old_sign if n == a else -old_sign,
+                                        self.system.size, self.dot)
+            except RECOVERABLE_ERRORS:
+                mu = None
+            end = BracketEnd(f, trial.load_factor, self.probes(trial.u), n, mu)
+            replaced.append("lo" if n == a else "hi")
+            lo, hi = (end, hi) if n == a else (lo, end)
+            previous, found = found, crossing_in(lo, hi, len(replaced))
+            if previous is not None and abs(found.load_factor - previous.load_factor) <= \
+                    LOCATE_RTOL * abs(found.load_factor):
+                break
+        state.crossing = found
 
     def _increment(self, last: PathState, trial: _Trial) -> float:
         """The step from ``last`` to ``trial`` in the units of the control (h's)."""

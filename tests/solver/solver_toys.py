@@ -135,6 +135,35 @@ class Pitchfork(ToySystem):
         return np.array([[self.k1, -y], [-y, self.k2 - x + 3.0 * y * y]])
 
 
+class CurvedPitchfork(ToySystem):
+    """A pitchfork whose critical eigenvalue is not linear in λ along the fundamental path.
+
+    Potential ``Π = ½ k1 x² + ⅓ a x³ + ½ k2 y² − ½ x y² + ¼ y⁴ − λ P x``: on ``y = 0``,
+    ``k1 x + a x² = λ P`` and the tangent is ``diag(k1 + 2 a x, k2 − x)``, singular at
+    ``x = k2``, i.e. ``λ_c = (k1 k2 + a k2²) / P``; the eigenvalue ``k2 − x(λ)`` is curved in λ.
+    """
+
+    dof_names = ("x", "y")
+    load_dof = 0
+
+    def __init__(self, k1: float = 2.0, k2: float = 1.0, a: float = 1.5) -> None:
+        super().__init__()
+        self.k1, self.k2, self.a = k1, k2, a
+
+    @property
+    def critical_load_factor(self) -> float:
+        return (self.k1 * self.k2 + self.a * self.k2**2) / self.p_ref
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        x, y = u
+        return np.array([self.k1 * x + self.a * x * x - 0.5 * y * y,
+                         self.k2 * y - x * y + y**3])
+
+    def tangent(self, u: np.ndarray) -> np.ndarray:
+        x, y = u
+        return np.array([[self.k1 + 2.0 * self.a * x, -y], [-y, self.k2 - x + 3.0 * y * y]])
+
+
 class BoundedDomain(ToySystem):
     """``f(u) = u / (1 − u)`` defined only for ``u < 1`` (NaN beyond): equilibrium
     ``u = λ / (1 + λ)``. A tangent predictor ``u = Δλ`` leaves the domain when ``Δλ ≥ 1 − u``."""
