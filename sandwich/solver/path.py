@@ -623,10 +623,11 @@ class _Follower:
         where the crossed eigenvalue, linear along the step, is zero. Then, with
         ``locate_bifurcations`` and a regular step of size ``h`` from ``last`` (``t`` its load
         tangent; None: a target's or a rescue's; for a kept bent step, the increment to it),
-        shorter steps from ``last``
-        aimed at that point narrow the bracket (regula falsi on the eigenvalue, Illinois'
-        rule); their equilibria are not path states, and the path's own settings
-        (contact-limited corrections) are left as they were.
+        shorter steps from ``last`` aimed at that point narrow the bracket (regula falsi on
+        the eigenvalue, Illinois' rule; the middle where an end's eigenvalue is unknown; after
+        a try that fails, half as far from the bracket's lower end). Their equilibria are not
+        path states, and the path's own settings (contact-limited corrections) are left as
+        they were.
         """
         a, b = last.negative_pivots, state.negative_pivots
         if a is None or b is None or a == b:
@@ -646,12 +647,14 @@ class _Follower:
             return
         old_sign = 1.0 if b > a else -1.0
         replaced: list[str] = []
+        retry = None  # after a try that failed: half as far from the bracket's lower end
         for _ in range(MAX_SUBSTEPS):
             if abs(hi.load_factor - lo.load_factor) <= LOCATE_RTOL * max(
                     abs(lo.load_factor), abs(hi.load_factor)):
                 break
-            f = next_fraction(halved(lo) if replaced[-2:] == ["hi", "hi"] else lo,
-                              halved(hi) if replaced[-2:] == ["lo", "lo"] else hi)
+            f = retry if retry is not None else next_fraction(
+                halved(lo) if replaced[-2:] == ["hi", "hi"] else lo,
+                halved(hi) if replaced[-2:] == ["lo", "lo"] else hi)
             failed_once = self.failed_once  # a failed try does not change the path's settings
             try:
                 trial, _ = self._attempt(f * h, last, t)
@@ -659,8 +662,9 @@ class _Follower:
                 trial = None
             self.failed_once = failed_once
             n = None if trial is None else trial.factorization.negative_pivots
+            retry = None if n is not None else lo.f + 0.5 * (f - lo.f)
             if n is None:
-                break
+                continue
             try:
                 mu = crossed_eigenvalue(trial.factorization, old_sign if n == a else -old_sign,
                                         self.system.size, self.dot)
