@@ -3,15 +3,15 @@
 A bifurcation is detected when the tangent's negative-pivot count changes between two converged
 states A and B (:mod:`sandwich.solver.limits`); it lies somewhere on that step, and reporting it
 at B is wrong by up to the whole step (first order in the step length: the longer steps the
-controller takes, the larger the error — 5-15 % of the load on the knock-down study's centred
-debonds, docs/studies.md).
+controller takes, the larger the error — up to 13 % of the load on the knock-down study's
+centred debonds, benchmarks/results/beam/critical_location.md).
 
 The eigenvalues that crossed zero are computed at both ends from the two factorisations the
 path already has (solves only: no tangent is evaluated, so the path that follows is not
 disturbed):
 
 * at B, the eigenvalues of K_B nearest zero by subspace inverse iteration (a block of
-  :data:`BLOCK` vectors more than the crossed ones, X ← orth(K⁻¹X), Rayleigh–Ritz on K⁻¹ over
+  :data:`BLOCK` + |change| − 1 vectors, X ← orth(K⁻¹X), Rayleigh–Ritz on K⁻¹ over
   span X); the crossed ones are the |change| nearest zero whose sign is the new one (negative
   where the count rose);
 * at A, the same iteration started from B's vectors; the Ritz vector nearest each of B's
@@ -25,8 +25,10 @@ reporting B's values is first order (`tests/solver/test_solver_critical_location
 order measured on a synthetic family, and on a pitchfork whose eigenvalue is not linear in λ).
 The eigenvalues are those of K in the Euclidean metric of the free unknowns (no mass or metric
 matrix): their zero crossing is the singular tangent whatever the metric; the metric only
-changes how straight μ(t) is. Two eigenvalues crossing on one step (the paper's element on
-fig. 6 and c1: two wrinkles, one either side of the debond's centre) are both located.
+changes how straight μ(t) is. Two eigenvalues crossing on one step are both located where the
+iteration reaches them: those nearest zero at B must include them (on fig. 6 and c1 at the
+paper's core both are far past zero at the step's end, behind smaller positive ones, and the
+step is not located from its ends; :mod:`sandwich.solver.path` can narrow it instead).
 
 Nothing is located (None) where the count changed by more than :data:`MAX_CROSSINGS`, an
 iteration did not settle in :data:`MAX_ITERATIONS`, or the matched eigenvalues do not change
@@ -40,17 +42,29 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sandwich.solver.system import _local_dot
+
 __all__ = ["BracketEnd", "Crossing", "CrossingFraction", "crossed_eigenvalue", "crossing_in",
            "locate_crossing", "nearest_eigenpairs", "next_fraction", "zero_fraction"]
 
-#: Vectors of the inverse-iteration block beyond the crossed eigenvalues' (at most the size).
+#: Vectors of the inverse-iteration block for one crossed eigenvalue (one more per further
+#: crossed one; at most the system's size).
 BLOCK = 3
 #: Most eigenvalues located on one step (a count that changed by more is not located).
 MAX_CROSSINGS = 2
 #: Inverse iterations allowed at each end of the step.
 MAX_ITERATIONS = 30
-#: Relative change of the crossed eigenvalue's Ritz value at which the iteration has converged.
-RITZ_TOL = 1e-6
+#: Relative change of the crossed eigenvalue's Ritz value at which the iteration has converged
+#: (an error ε in μ at the two ends moves the located fraction t by at most ε t (1 − t) · 2).
+RITZ_TOL = 1e-4
+#: Equilibria solved inside a step across a bifurcation to narrow it (each one corrector of a
+#: shorter step from the state before), with ``PathOptions.locate_bifurcations``.
+MAX_SUBSTEPS = 3
+#: Narrowing stops once the located load factor moves by less than this (relative), or the
+#: bracket is narrower than it.
+LOCATE_RTOL = 2e-3
+#: A regula-falsi try stays this fraction of the bracket away from either end.
+SAFEGUARD = 0.05
 
 
 @dataclass(frozen=True)
@@ -71,6 +85,9 @@ def _solve_block(fac: object, X: np.ndarray) -> np.ndarray:
 
 
 def _gram(dot: Callable, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """XᵀY under ``dot`` (one product where it is the plain local one; MPI: pair by pair)."""
+    if dot is _local_dot:
+        return X.T @ Y
     m = X.shape[1]
     return np.array([[dot(X[:, i], Y[:, j]) for j in range(m)] for i in range(m)])
 
@@ -265,13 +282,3 @@ def crossing_in(lo: BracketEnd, hi: BracketEnd, substeps: int) -> Crossing:
                     {n: v + s * (hi.probes[n] - v) for n, v in lo.probes.items()
                      if n in hi.probes},
                     (lo.load_factor, hi.load_factor), substeps)
-
-
-#: Equilibria solved inside a step across a bifurcation to narrow it (each one corrector of a
-#: shorter step from the state before), with ``PathOptions.locate_bifurcations``.
-MAX_SUBSTEPS = 3
-#: Narrowing stops once the located load factor moves by less than this (relative), or the
-#: bracket is narrower than it.
-LOCATE_RTOL = 2e-3
-#: A regula-falsi try stays this fraction of the bracket away from either end.
-SAFEGUARD = 0.05
