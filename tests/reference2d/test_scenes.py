@@ -73,3 +73,24 @@ def test_full_path_coarse(name):
     scene = load_scene(SCENES / f"{name}.toml")
     sol = solve(scene, level="coarse")
     _check(sol, scene)
+
+
+@pytest.mark.timeout(300)
+def test_fig5_bifurcation_is_located_within_its_step_and_the_path_is_unchanged():
+    # the shared path follower locates the 2D model's bifurcation too (docs/solver.md): from
+    # the step's two factorisations (the state before's MUMPS handle refactors it) and, with
+    # locate_bifurcations, by equilibria inside the step; reference: the 2D run's own states
+    # (the bracket) and the same path with narrowing off (bit for bit)
+    scene = _short(load_scene(SCENES / f"{FIG5}.toml"), -5.0)
+    plain = solve(scene, level="coarse")
+    narrowed = solve(dataclasses.replace(scene, analysis=dataclasses.replace(
+        scene.analysis, locate_bifurcations=True)), level="coarse")
+    assert [r.load_factor for r in plain.history] == [r.load_factor for r in narrowed.history]
+    p, = [lp for lp in plain.limit_points if lp.kind == "bifurcation"]
+    n, = [lp for lp in narrowed.limit_points if lp.kind == "bifurcation"]
+    at_state = next(r.load_factor for r in plain.history if r.step == p.step)
+    before = next(r.load_factor for r in plain.history if r.step == p.step - 1)
+    assert p.between == (before, at_state) and before < p.load_factor < at_state
+    assert 0.0 < p.located_at < 1.0
+    assert before <= n.between[0] < n.load_factor < n.between[1] <= at_state
+    assert n.between[1] - n.between[0] < 0.5 * (at_state - before)

@@ -42,3 +42,16 @@ def test_the_bracket_goes_through_summary_json_and_older_files_read_without_it(t
     write_solution(sol, tmp_path)
     back = load_result(tmp_path, fields=False)
     assert [lp.between for lp in back.limit_points] == [(6.0, 9.0), None]
+
+
+def test_a_located_bifurcation_goes_through_summary_json(tmp_path):
+    # located at 0.4 of its step (sandwich.solver.critical): the fraction is written and read
+    # back; a point without it reads back as None (files written before it existed)
+    history = [StepRecord(0, 0.0, {"w": 0.0}, 0), StepRecord(1, 9.0, {"w": -1.0}, 3)]
+    lps = [LimitPoint("bifurcation", 1, 7.2, {"w": -0.4}, (6.0, 9.0), 0.4),
+           LimitPoint("max", 1, 9.0, {"w": -1.0})]
+    sol = Solution("beam", "s", history, [], True, "reached", lps, 1.0, 10, {})
+    write_solution(sol, tmp_path)
+    back = load_result(tmp_path, fields=False)
+    assert [lp.located_at for lp in back.limit_points] == [0.4, None]
+    assert back.limit_points[0].load_factor == 7.2 and back.limit_points[0].probes == {"w": -0.4}
