@@ -158,7 +158,7 @@ def locate_crossing(
     displacement increment.
     """
     crossed = abs(change)
-    if not 0 < crossed <= MAX_CROSSINGS or size <= crossed:
+    if not 0 < crossed <= MAX_CROSSINGS or size < crossed:
         return None
     m = min(BLOCK + crossed - 1, size)
     rng = np.random.default_rng(20261205)  # a fixed start: the same answer on every run
@@ -224,7 +224,8 @@ class Crossing:
     ``load_factor`` and ``probes`` (interpolated between the ends of the final bracket),
     ``between`` the load factors of that bracket's ends (converged equilibria either side of
     the crossing: the step's two states, or equilibria solved inside it), ``substeps`` how many
-    such equilibria were solved.
+    such equilibria were solved, ``kind`` what it is (``"bifurcation"``, or ``"max"`` /
+    ``"min"`` where the equilibria inside the step rise above / fall below both of its states).
     """
 
     fraction: float
@@ -232,6 +233,9 @@ class Crossing:
     probes: dict[str, float]
     between: tuple[float, float]
     substeps: int = 0
+    # "max" / "min" where the located point's load lies beyond both of the step's states: the
+    # count changed at a load extremum inside the step that the states did not sample
+    kind: str = "bifurcation"
 
 
 def crossed_eigenvalue(fac: object, sign: float, size: int, dot: Callable) -> float | None:

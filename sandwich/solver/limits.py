@@ -16,7 +16,10 @@ carries a ``crossing`` (located within its step by the path follower:
 factor and probes are the located point's, ``between`` the bracket it was located in (the
 step's states, or equilibria solved inside the step), ``located_at`` its fraction of the step.
 Without one (a change of the count shared with a limit point, a location that failed, states
-from elsewhere) it is reported at the first state with the new count.
+from elsewhere) it is reported at the first state with the new count. A narrowed step whose
+equilibria inside rise above both of its states (or fall below) had a load maximum (minimum)
+there that the states did not sample: the point is then reported as that ``"max"``
+(``"min"``), at the crossing.
 """
 
 from __future__ import annotations
@@ -71,7 +74,8 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
             s = states[k]
             c = getattr(s, "crossing", None)
             if c is not None and change == abs(b - a):  # located, no limit point shares it
-                found.append(LimitPoint("bifurcation", s.step, float(c.load_factor),
+                found.append(LimitPoint(getattr(c, "kind", "bifurcation"), s.step,
+                                        float(c.load_factor),
                                         dict(c.probes), tuple(map(float, c.between)),
                                         float(c.fraction)))
             else:

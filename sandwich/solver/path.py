@@ -49,6 +49,7 @@ so in the linear range the λ and u parts of the arc weigh the same.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass, field
@@ -494,8 +495,7 @@ class _Follower:
                 t_next = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
-            regular = not (direct or crossed or step in self.rescues)
-            self._locate_crossing(state, last, fac_before, fac, t, h_try if regular else None)
+            self._locate_crossing(state, last, fac_before, fac, t, self._increment(last, trial))
             t = t_next
             done = self._target_reached()
             if done:
@@ -615,15 +615,16 @@ class _Follower:
         return trial
 
     def _locate_crossing(self, state: PathState, last: PathState, fac_before: object,
-                         fac: object, t: np.ndarray, h: float | None) -> None:
+                         fac: object, t: np.ndarray, h: float) -> None:
         """Locate a bifurcation within the step ``last`` → ``state`` (their inertia differs).
 
         First from the two factorisations the step has
         (:func:`~sandwich.solver.critical.locate_crossing`: solves only, no tangent evaluated):
         where the crossed eigenvalue, linear along the step, is zero. Then, with
-        ``locate_bifurcations`` and a regular step of size ``h`` from ``last`` (``t`` its load
-        tangent; None: a target's or a rescue's; for a kept bent step, the increment to it),
-        shorter steps from ``last`` aimed at that point narrow the bracket (regula falsi on
+        ``locate_bifurcations``, steps from ``last`` under the path's control (``t`` its load
+        tangent), shorter than the step's increment ``h`` in the control's units (whether the
+        step was the controller's, a target's, a rescue's or a kept bent one) and aimed at that
+        point, narrow the bracket (regula falsi on
         the eigenvalue, Illinois' rule; the middle where an end's eigenvalue is unknown; after
         a try that fails, half as far from the bracket's lower end). Their equilibria are not
         path states, and the path's own settings (contact-limited corrections) are left as
@@ -642,7 +643,7 @@ class _Follower:
         hi = BracketEnd(1.0, state.load_factor, dict(state.probes), b,
                         None if c is None else c.mu_after)
         found = None if c is None else crossing_in(lo, hi, 0)
-        if not self.opt.locate_bifurcations or h is None or abs(b - a) > MAX_CROSSINGS:
+        if not self.opt.locate_bifurcations or not h > 0.0 or abs(b - a) > MAX_CROSSINGS:
             state.crossing = found
             return
         old_sign = 1.0 if b > a else -1.0
@@ -677,6 +678,11 @@ class _Follower:
             if previous is not None and abs(found.load_factor - previous.load_factor) <= \
                     LOCATE_RTOL * abs(found.load_factor):
                 break
+        ends = (last.load_factor, state.load_factor)
+        if found is not None and min(lo.load_factor, hi.load_factor) > max(ends):
+            found = dataclasses.replace(found, kind="max")  # a maximum inside the step
+        elif found is not None and max(lo.load_factor, hi.load_factor) < min(ends):
+            found = dataclasses.replace(found, kind="min")
         state.crossing = found
 
     def _increment(self, last: PathState, trial: _Trial) -> float:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from solver_toys import CurvedPitchfork, Pitchfork
+from solver_toys import CurvedPitchfork, Pitchfork, VonMisesTruss
 
 from sandwich.solver import PathOptions, SparseFactorization, follow_path
 from sandwich.solver.critical import locate_crossing
@@ -140,3 +140,29 @@ def test_the_scene_key_reaches_the_path_follower(tmp_path):
     analysis = load_scene(path).analysis
     assert analysis.locate_bifurcations is True
     assert PathOptions.from_analysis(analysis).locate_bifurcations is True
+
+
+def test_a_load_maximum_inside_one_step_is_found_by_narrowing():
+    # one displacement step from the unloaded truss to w = 0.2, past its maximum at
+    # w = 0.175 (closed form, solver_toys.VonMisesTruss.limit_points): the states (λ 0 and
+    # 20.8) never show the maximum, only the inertia change; the equilibria solved inside the
+    # step rise above both, so the point is the maximum, located at the crossing
+    truss = VonMisesTruss()
+    (w_max, lam_max), _ = truss.limit_points()
+    assert 0.0 < w_max < 0.2
+
+    def follow(locate):
+        opts = PathOptions(control="displacement", until_probe="w", until_value=0.2,
+                           initial_increment=0.2, max_increment=0.2, tol=1e-10,
+                           locate_bifurcations=locate)
+        return follow_path(VonMisesTruss(), opts, ["w"])
+
+    plain, narrowed = follow(False), follow(True)
+    assert [s.load_factor for s in plain.states] == [s.load_factor for s in narrowed.states]
+    assert len(plain.states) == 2 and plain.states[1].load_factor < lam_max
+    p, = plain.limit_points
+    assert p.kind == "bifurcation" and p.load_factor < plain.states[1].load_factor
+    n, = narrowed.limit_points
+    assert n.kind == "max"
+    assert n.load_factor == pytest.approx(lam_max, rel=2e-3)
+    assert n.probes["w"] == pytest.approx(w_max, rel=0.05)
