@@ -495,7 +495,7 @@ class _Follower:
                 t_next = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
-            self._locate_crossing(state, last, fac_before, fac, t, self._increment(last, trial))
+            self._locate_crossing(state, last, fac_before, fac, t)
             t = t_next
             done = self._target_reached()
             if done:
@@ -615,24 +615,24 @@ class _Follower:
         return trial
 
     def _locate_crossing(self, state: PathState, last: PathState, fac_before: object,
-                         fac: object, t: np.ndarray, h: float) -> None:
+                         fac: object, t: np.ndarray) -> None:
         """Locate a bifurcation within the step ``last`` → ``state`` (their inertia differs).
 
         First from the two factorisations the step has
         (:func:`~sandwich.solver.critical.locate_crossing`: solves only, no tangent evaluated):
         where the crossed eigenvalue, linear along the step, is zero. Then, with
         ``locate_bifurcations``, steps from ``last`` under the path's control (``t`` its load
-        tangent), shorter than the step's increment ``h`` in the control's units (whether the
-        step was the controller's, a target's, a rescue's or a kept bent one) and aimed at that
-        point, narrow the bracket (regula falsi on
-        the eigenvalue, Illinois' rule; the middle where an end's eigenvalue is unknown; after
-        a try that fails, half as far from the bracket's lower end). Their equilibria are not
-        path states, and the path's own settings (contact-limited corrections) are left as
-        they were.
+        tangent), shorter than the step's increment h in the control's units (whether the step
+        was the controller's, a target's, a rescue's or a kept bent one) and aimed at that
+        point, narrow the bracket (regula falsi on the eigenvalue, Illinois' rule; the middle
+        where an end's eigenvalue is unknown; after a try that fails, half as far from the
+        bracket's lower end). Their equilibria are not path states, and the path's own
+        settings (contact-limited corrections) are left as they were.
         """
         a, b = last.negative_pivots, state.negative_pivots
         if a is None or b is None or a == b:
             return
+        h = self._increment(last, state)
         try:
             c = locate_crossing(fac_before, fac, b - a, self.system.size, self.dot,
                                 state.u - last.u)
@@ -685,7 +685,7 @@ class _Follower:
             found = dataclasses.replace(found, kind="min")
         state.crossing = found
 
-    def _increment(self, last: PathState, trial: _Trial) -> float:
+    def _increment(self, last: PathState, trial: _Trial | PathState) -> float:
         """The step from ``last`` to ``trial`` in the units of the control (h's)."""
         dl = trial.load_factor - last.load_factor
         if self.opt.control == "load":
