@@ -158,3 +158,19 @@ def test_two_ranks_give_the_serial_history_cantilever_with_debonds_at_the_clamp(
     assert all(abs(a["iterations"] - b["iterations"]) <= 1 for a, b in zip(ser, mpi, strict=True))
     assert summary["serial"]["max_penetration_over_face_thickness"] <= 1e-3
     print(f"c4: worst relative history difference {worst:.2e}")
+
+
+def test_two_ranks_locate_the_bifurcation_where_one_rank_does(tmp_path):
+    """fig5 to -5 mm: the bifurcation located within its step (the crossed eigenvalue's inverse
+    iteration with global inner products and collective solves) is the serial run's."""
+    scene = _scene(tmp_path, "paper-fig5-top-debond-40-load-top", "-15", "-5", "fig5-mpi-bif")
+    serial, par = _serial_and_two_ranks(scene, tmp_path)
+    points = [json.loads((d / "summary.json").read_text())["limit_points"]
+              for d in (serial, par)]
+    (s,), (p,) = ([lp for lp in pts if lp["kind"] == "bifurcation"] for pts in points)
+    assert s["step"] == p["step"] and 0.0 < s["located_at_step_fraction"] < 1.0
+    low, high = s["between_load_factors"]
+    assert low < s["load_factor"] < high  # located inside the step, not at its end
+    assert p["load_factor"] == pytest.approx(s["load_factor"], rel=1e-6)
+    assert p["located_at_step_fraction"] == pytest.approx(s["located_at_step_fraction"],
+                                                          rel=1e-5)
