@@ -37,6 +37,7 @@ sign: the bifurcation is then reported at B as before.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -77,7 +78,11 @@ class CrossingFraction:
     t: float
     mu_before: float  # the crossed eigenvalue at A
     mu_after: float  # at B
-    iterations: int  # inverse iterations at both ends
+
+
+def _start_block(size: int, m: int) -> np.ndarray:
+    """A fixed pseudo-random (size, m) start block: the same answer on every run."""
+    return np.random.default_rng(20261205).standard_normal((size, m))
 
 
 def _solve_block(fac: object, X: np.ndarray) -> np.ndarray:
@@ -161,8 +166,7 @@ def locate_crossing(
     if not 0 < crossed <= MAX_CROSSINGS or size < crossed:
         return None
     m = min(BLOCK + crossed - 1, size)
-    rng = np.random.default_rng(20261205)  # a fixed start: the same answer on every run
-    start = rng.standard_normal((size, m))
+    start = _start_block(size, m)
     if seed_vector is not None and m > crossed and np.all(np.isfinite(seed_vector)) \
             and np.any(seed_vector):
         start[:, -1] = seed_vector
@@ -177,7 +181,7 @@ def locate_crossing(
     after = nearest_eigenpairs(fac_after, start, dot, nearest_of_new_sign)
     if after is None:
         return None
-    mu_b, V_b, its_b = after
+    mu_b, V_b, _ = after
 
     def same_modes(mu: np.ndarray, V: np.ndarray) -> np.ndarray:
         overlap = np.abs(np.array([[dot(V[:, j], V_b[:, i]) for j in range(V.shape[1])]
@@ -190,29 +194,27 @@ def locate_crossing(
     before = nearest_eigenpairs(fac_before, start_a, dot, same_modes)
     if before is None:
         return None
-    mu_a, _, its_a = before
+    mu_a, _, _ = before
     if not np.all(np.sign(mu_a) == -new_sign):
         return None
     t = mu_a / (mu_a - mu_b)
     first = int(np.argmin(t))
     if not 0.0 < t[first] < 1.0:  # pragma: no cover - opposite signs give t in (0, 1)
         return None
-    return CrossingFraction(float(t[first]), float(mu_a[first]), float(mu_b[first]),
-                            its_a + its_b)
+    return CrossingFraction(float(t[first]), float(mu_a[first]), float(mu_b[first]))
 
 
 @dataclass(frozen=True)
 class BracketEnd:
     """A converged equilibrium on a step across a critical point.
 
-    Its fraction ``f`` of the step's size from the state before, its load factor, probes,
-    inertia and crossed μ.
+    Its fraction ``f`` of the step's size from the state before, its load factor, probes and
+    crossed μ.
     """
 
     f: float
     load_factor: float
     probes: dict[str, float]
-    negative_pivots: int
     mu: float | None  # the crossed eigenvalue there (None: not found)
 
 
@@ -243,7 +245,7 @@ def crossed_eigenvalue(fac: object, sign: float, size: int, dot: Callable) -> fl
     m = min(BLOCK, size)
     if m < 1:
         return None
-    start = np.random.default_rng(20261205).standard_normal((size, m))
+    start = _start_block(size, m)
 
     def nearest_of_sign(mu: np.ndarray, V: np.ndarray) -> np.ndarray:
         ok = np.flatnonzero(np.sign(mu) == sign)
@@ -274,8 +276,7 @@ def next_fraction(lo: BracketEnd, hi: BracketEnd) -> float:
 
 def halved(end: BracketEnd) -> BracketEnd:
     """``end`` with its μ halved (Illinois: an end kept by two tries weighs half)."""
-    return end if end.mu is None else BracketEnd(end.f, end.load_factor, end.probes,
-                                                 end.negative_pivots, 0.5 * end.mu)
+    return end if end.mu is None else dataclasses.replace(end, mu=0.5 * end.mu)
 
 
 def crossing_in(lo: BracketEnd, hi: BracketEnd, substeps: int) -> Crossing:

@@ -74,10 +74,8 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
             s = states[k]
             c = getattr(s, "crossing", None)
             if c is not None and change == abs(b - a):  # located, no limit point shares it
-                found.append(LimitPoint(getattr(c, "kind", "bifurcation"), s.step,
-                                        float(c.load_factor),
-                                        dict(c.probes), tuple(map(float, c.between)),
-                                        float(c.fraction)))
+                found.append(LimitPoint(c.kind, s.step, float(c.load_factor), dict(c.probes),
+                                        tuple(map(float, c.between)), float(c.fraction)))
             else:
                 found.append(LimitPoint("bifurcation", s.step, float(s.load_factor),
                                         dict(s.probes), (float(lam[k - 1]), float(lam[k]))))

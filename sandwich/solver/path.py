@@ -638,9 +638,9 @@ class _Follower:
                                 state.u - last.u)
         except RECOVERABLE_ERRORS:  # a solve that fails: reported at the state, as before
             c = None
-        lo = BracketEnd(0.0, last.load_factor, dict(last.probes), a,
+        lo = BracketEnd(0.0, last.load_factor, dict(last.probes),
                         None if c is None else c.mu_before)
-        hi = BracketEnd(1.0, state.load_factor, dict(state.probes), b,
+        hi = BracketEnd(1.0, state.load_factor, dict(state.probes),
                         None if c is None else c.mu_after)
         found = None if c is None else crossing_in(lo, hi, 0)
         if not self.opt.locate_bifurcations or not h > 0.0 or abs(b - a) > MAX_CROSSINGS:
@@ -671,7 +671,7 @@ class _Follower:
                                         self.system.size, self.dot)
             except RECOVERABLE_ERRORS:
                 mu = None
-            end = BracketEnd(f, trial.load_factor, self.probes(trial.u), n, mu)
+            end = BracketEnd(f, trial.load_factor, self.probes(trial.u), mu)
             replaced.append("lo" if n == a else "hi")
             lo, hi = (end, hi) if n == a else (lo, end)
             previous, found = found, crossing_in(lo, hi, len(replaced))
