@@ -1,16 +1,22 @@
 """Limit points and bifurcations read off a computed equilibrium path.
 
-- A *limit point* is a converged state where λ has a local extremum along the path: the
-  increments Δλ before and after it have opposite signs (zero increments are skipped). It is
-  reported at that state (so its load factor is exact only to the step resolution).
+- A *limit point* is a local extremum of λ along the path. The states show it where the
+  increments Δλ before and after a state have opposite signs (zero increments are skipped);
+  the path follower locates it within the step before or after that state from the load
+  curve's slopes (:mod:`sandwich.solver.extrema`, a state's ``extremum``), and it is reported
+  there: ``located_at`` the fraction of that step's probe change, ``between`` that step's two
+  load factors. Without a located one it is reported at the extreme state (exact only to the
+  step resolution: the two increments' loads are its ``between``). An extremum located inside
+  a step whose states do not show it (both sides of the top on one step and no state beyond)
+  is reported as well.
 - A *bifurcation* is a change of the tangent's negative-pivot count between two successive states
   that is not explained by a limit point: a simple limit point changes the count by one between
   the state before and the state after it; any further change (or a change with no limit point
   next to it) is a bifurcation on that step (located within it, below).
 
 Each point carries ``between``: the load factors of the two converged states that enclose it
-along the path (the states either side of an extremum; the state before a bifurcation and the
-one reported), so a user sees to what resolution the path sampled it. A bifurcation whose state
+along the path (its step's states; an extremum not located: the states either side of it),
+so a user sees to what resolution the path sampled it. A bifurcation whose state
 carries a ``crossing`` (located within its step by the path follower:
 :meth:`sandwich.solver.path._Follower._locate_crossing`) is reported there instead: its load
 factor and probes are the located point's, ``between`` the bracket it was located in (the
@@ -41,8 +47,33 @@ class _State(Protocol):
     negative_pivots: int | None
 
 
+def _located_extremum(states: Sequence[_State], steps: Sequence[int], kind: str) -> int | None:
+    """The state among ``steps`` whose step has a located extremum of ``kind`` (the top one)."""
+    found = [m for m in steps if 0 < m < len(states)
+             and (e := getattr(states[m], "extremum", None)) is not None and e.kind == kind]
+    if not found:
+        return None
+    sign = 1.0 if kind == "max" else -1.0
+    return max(found, key=lambda m: sign * states[m].extremum.load_factor)
+
+
+def _from_extremum(state: _State) -> LimitPoint:
+    e = state.extremum
+    return LimitPoint(e.kind, state.step, float(e.load_factor), dict(e.probes),
+                      tuple(map(float, e.between)), float(e.fraction))
+
+
+def _position(lp: LimitPoint) -> float:
+    """Where a point lies along the path, in steps (a located one inside its step)."""
+    return lp.step - 1 + lp.located_at if lp.located_at is not None else float(lp.step)
+
+
 def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
-    """Return the limit points and bifurcations along ``states`` (ordered by step)."""
+    """Return the limit points and bifurcations along ``states`` (ordered along the path).
+
+    The order is by position along the path: a point located within step k lies at
+    k − 1 + its fraction of the step, one reported at state k at k.
+    """
     n = len(states)
     if n < 2:
         return []
@@ -50,6 +81,7 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
     dlam = np.diff(lam)
     found: list[LimitPoint] = []
     limit_at: set[int] = set()
+    taken: set[int] = set()  # states whose located extremum is reported
     nz = np.flatnonzero(dlam != 0.0)  # increment j goes from state j to state j + 1
     for j0, j1 in zip(nz[:-1], nz[1:], strict=True):
         if np.sign(dlam[j0]) != np.sign(dlam[j1]):
@@ -57,9 +89,19 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
             kind = "max" if dlam[j0] > 0 else "min"
             s = states[k]
             after = int(j1) + 1  # the state that ends the next non-zero increment
+            limit_at.add(k)
+            m = _located_extremum(states, (k, after), kind)
+            if m is not None and m not in taken:  # located within the step before or after k
+                taken.add(m)
+                found.append(_from_extremum(states[m]))
+                continue
             found.append(LimitPoint(kind, s.step, float(s.load_factor), dict(s.probes),
                                     (float(lam[int(j0)]), float(lam[after]))))
-            limit_at.add(k)
+    for m in range(1, n):  # located inside a step whose states do not show it
+        if m not in taken and getattr(states[m], "extremum", None) is not None:
+            taken.add(m)
+            limit_at.add(m)
+            found.append(_from_extremum(states[m]))
     used: set[int] = set()
     for k in range(1, n):
         a, b = states[k - 1].negative_pivots, states[k].negative_pivots
@@ -79,5 +121,5 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
             else:
                 found.append(LimitPoint("bifurcation", s.step, float(s.load_factor),
                                         dict(s.probes), (float(lam[k - 1]), float(lam[k]))))
-    found.sort(key=lambda lp: lp.step)
+    found.sort(key=_position)
     return found

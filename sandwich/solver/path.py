@@ -62,6 +62,7 @@ from sandwich.solver.critical import (
     LOCATE_RTOL,
     MAX_CROSSINGS,
     MAX_SUBSTEPS,
+    SAFEGUARD,
     BracketEnd,
     Crossing,
     crossed_eigenvalue,
@@ -70,6 +71,7 @@ from sandwich.solver.critical import (
     locate_crossing,
     next_fraction,
 )
+from sandwich.solver.extrema import Extremum, SlopeEnd, located_in, turns_over
 from sandwich.solver.limits import find_limit_points
 from sandwich.solver.newton import (
     RECOVERABLE_ERRORS,
@@ -258,6 +260,11 @@ class PathState:
     # within the step (:meth:`_Follower._locate_crossing`), None if it did not change or could
     # not be located
     crossing: Crossing | None = None
+    # dw/dλ of the load curve's probe w along the path here, c·K⁻¹f_ref (from the next step's
+    # load tangent; None without that probe or where the tangent failed)
+    probe_rate: float | None = None
+    # the load extremum located within the step that ends here (:mod:`sandwich.solver.extrema`)
+    extremum: Extremum | None = None
     # per-state history columns the model adds (``system.state_columns(u)``, optional): kept on
     # the state so that an interrupted run still writes them (e.g. G at the debond tips)
     extra: dict[str, float | None] = field(default_factory=dict)
@@ -447,13 +454,16 @@ class _Follower:
         except RECOVERABLE_ERRORS as exc:
             yield self.accept(u0, 0.0, 0, None, 0)
             return self.finish(False, f"step 1: the initial tangent cannot be factorised ({exc})")
-        yield self.accept(u0, 0.0, 0, fac.negative_pivots, 0)
+        first = self.accept(u0, 0.0, 0, fac.negative_pivots, 0)
+        yield first
         tn = math.sqrt(self.dot(t, t))
         if not math.isfinite(tn) or tn == 0.0:
             return self.finish(False, "step 1: f_ref is zero or the linear solution is not finite")
         self.psi = opt.arc_load_weight * tn
         self.lam_est = self._target_load_estimate(t)
         self.curve_probe = self._curve_probe(t)
+        self.rate_probe = opt.driven_probe or self.curve_probe[0]
+        first.probe_rate = self._probe_rate(t)
         size = _StepSize.start(opt, lambda: self._auto_increment(t))
         self.prev_step: tuple[np.ndarray, float] | None = None
         self.recent: list[tuple[float, float]] = []  # (increment, until-probe change) accepted
@@ -496,6 +506,8 @@ class _Follower:
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
             self._locate_crossing(state, last, fac_before, fac, t)
+            state.probe_rate = self._probe_rate(t_next)
+            self._locate_extremum(state, last, t)
             t = t_next
             done = self._target_reached()
             if done:
@@ -656,12 +668,7 @@ class _Follower:
             f = retry if retry is not None else next_fraction(
                 halved(lo) if replaced[-2:] == ["hi", "hi"] else lo,
                 halved(hi) if replaced[-2:] == ["lo", "lo"] else hi)
-            failed_once = self.failed_once  # a failed try does not change the path's settings
-            try:
-                trial, _ = self._attempt(f * h, last, t)
-            except RECOVERABLE_ERRORS:
-                trial = None
-            self.failed_once = failed_once
+            trial = self._inside_step(f * h, last, t)
             n = None if trial is None else trial.factorization.negative_pivots
             retry = None if n is not None else lo.f + 0.5 * (f - lo.f)
             if n is None:
@@ -684,6 +691,91 @@ class _Follower:
         elif found is not None and max(lo.load_factor, hi.load_factor) < min(ends):
             found = dataclasses.replace(found, kind="min")
         state.crossing = found
+
+    def _probe_rate(self, t: np.ndarray) -> float | None:
+        """dw/dλ = c·t of the load curve's probe w (:attr:`rate_probe`) for the load tangent t."""
+        if self.rate_probe is None:
+            return None
+        rate = self.dot(self.c[self.rate_probe], t)
+        return float(rate) if math.isfinite(rate) else None
+
+    def _locate_extremum(self, state: PathState, last: PathState, t: np.ndarray) -> None:
+        """Locate a load extremum within the step ``last`` → ``state`` (:mod:`~.extrema`).
+
+        From the two states' loads, probes and slopes dw/dλ alone (no solve): where the load
+        curve's tangent turns over within the step (in the plane the settling test measures
+        bends in: the probe / its linear value at the target's load, λ / the target's load),
+        the stationary point of λ's cubic Hermite interpolant in w. Then, with
+        ``locate_bifurcations``, steps from ``last`` under the path's control (``t`` its load
+        tangent) aimed at that point narrow the bracket, each equilibrium's slope from one
+        solve with its factorised tangent, as :meth:`_locate_crossing` narrows a bifurcation.
+        """
+        name, qa, qb = self.rate_probe, last.probe_rate, state.probe_rate
+        if name is None or qa is None or qb is None:
+            return
+        wa, wb = last.probes[name], state.probes[name]
+        lam_scale = abs(self.lam_est) or 1.0
+        w_scale = abs(self.states[0].probe_rate or 0.0) * lam_scale
+
+        def kind_between(a: SlopeEnd, b: SlopeEnd) -> str | None:
+            return turns_over(b.probes[name] - a.probes[name], b.load_factor - a.load_factor,
+                              a.rate, b.rate, w_scale, lam_scale)
+
+        lo = SlopeEnd(0.0, last.load_factor, dict(last.probes), qa)
+        hi = SlopeEnd(1.0, state.load_factor, dict(state.probes), qb)
+        kind = kind_between(lo, hi)
+        found = None if kind is None else located_in(lo, hi, name)
+        if found is None:
+            return
+        h = self._increment(last, state)
+        retry = None
+        for _ in range(MAX_SUBSTEPS if self.opt.locate_bifurcations and h > 0.0 else 0):
+            w = hi.f - lo.f
+            f = retry if retry is not None else min(max(found[0], lo.f + SAFEGUARD * w),
+                                                    hi.f - SAFEGUARD * w)
+            trial = self._inside_step(f * h, last, t)
+            rate = None
+            if trial is not None:
+                try:
+                    rate = self._probe_rate(np.asarray(trial.factorization.solve(self.f_ref),
+                                                       dtype=float))
+                except RECOVERABLE_ERRORS:
+                    rate = None
+            retry = None if rate is not None else lo.f + 0.5 * (f - lo.f)
+            if rate is None:
+                continue
+            mid = SlopeEnd(f, trial.load_factor, self.probes(trial.u), rate)
+            if kind_between(lo, mid) == kind:
+                hi = mid
+            elif kind_between(mid, hi) == kind:
+                lo = mid
+            else:  # the try's slope fits neither side: keep what the bracket had
+                break
+            previous, found = found, located_in(lo, hi, name)
+            if found is None:
+                found = previous
+                break
+            if abs(found[1] - previous[1]) <= LOCATE_RTOL * abs(found[1]):
+                break
+        f, lam = found
+        s = (f - lo.f) / (hi.f - lo.f)  # linear in the probe between the bracket's ends
+        probes = {n: v + s * (hi.probes[n] - v) for n, v in lo.probes.items()}
+        x = (probes[name] - wa) / (wb - wa)
+        state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
+
+    def _inside_step(self, h: float, last: PathState, t: np.ndarray) -> _Trial | None:
+        """A step of ``h`` from ``last`` whose equilibrium is not a path state (or None).
+
+        For narrowing a critical point: the path's settings (contact-limited corrections, the
+        arc's sense) are left as they were, whatever the corrector does.
+        """
+        failed_once, sigma = self.failed_once, self.sigma
+        try:
+            trial, _ = self._attempt(h, last, t)
+        except RECOVERABLE_ERRORS:
+            trial = None
+        self.failed_once, self.sigma = failed_once, sigma
+        return trial
 
     def _increment(self, last: PathState, trial: _Trial | PathState) -> float:
         """The step from ``last`` to ``trial`` in the units of the control (h's)."""

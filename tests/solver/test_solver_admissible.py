@@ -11,6 +11,7 @@ Venant–Kirchhoff bar crushed by a dead load (:class:`solver_toys.SvkBar`, clos
 import math
 
 import numpy as np
+import pytest
 from solver_toys import SvkBar
 
 from sandwich.solver import PathOptions, follow_path
@@ -51,12 +52,20 @@ def test_path_stops_at_the_admissible_boundary_without_sign_change():
                                atol=TOL * lam.max())
     # it went up to the boundary (s → 0, λ → 0), not stopped early
     assert s[-1] < 0.02 and lam[-1] < 0.05 * lam.max()
-    # exactly one load maximum, at the material limit s = 1/√3, within the Taylor bound
+    # exactly one load maximum, at the material limit s = 1/√3 (closed form). It is located
+    # within its step (sandwich.solver.extrema): λ(w) of this bar is a cubic, which the cubic
+    # Hermite interpolant of the step reproduces, so the located top is the closed form's to
+    # round-off, where the extreme state is off by up to the Taylor bound ½ sup|f''| h²
     lam_max = system.ea / (3.0 * math.sqrt(3.0)) / system.p_ref
     assert [lp.kind for lp in result.limit_points] == ["max"]
     lp = result.limit_points[0]
     i = lp.step
-    h = max(w[i] - w[i - 1], w[i + 1] - w[i])
+    assert lp.located_at is not None and 0.0 < lp.located_at < 1.0
+    assert w[i - 1] < lp.probes["w"] < w[i]
+    assert lp.load_factor == pytest.approx(lam_max, rel=1e-12)
+    assert system.stretch(lp.probes["w"]) == pytest.approx(1.0 / math.sqrt(3.0), rel=1e-9)
+    top = int(np.argmax(lam))  # the extreme state: within the Taylor bound, below
+    h = max(w[top] - w[top - 1], w[top + 1] - w[top])
     bound = 0.5 * (3.0 * system.ea / system.length**2) * h * h  # sup|f''| = 3 EA s / L² ≤ 3 EA/L²
-    assert lam_max - bound <= lp.load_factor <= lam_max
+    assert lam_max - bound <= lam[top] <= lam_max
     assert bound < 0.02 * lam_max
