@@ -11,7 +11,7 @@ the scene's other defaults) with a top debond centred under the load (x = 150 mm
 - readings: *at state* — the first state with the new negative-pivot count (what every model
   reported before 2026-12-05) —; *located* — where the tangent's crossed eigenvalue,
   interpolated linearly along the step between the two states' factorisations, is zero (the
-  default now, no corrector); *narrowed* — ``[analysis] locate_bifurcations = true``: shorter
+  default now, no corrector); *narrowed* — ``[analysis] locate_critical_points = true``: shorter
   steps from the state before aimed at that point, regula falsi on the eigenvalue (a run of
   its own: the path's states are the same, its time is not).
 
@@ -44,7 +44,7 @@ def case(length: float, how: str, fine: float, narrowed: bool):
     debonds = tuple(dataclasses.replace(d, start=150.0 - length / 2, end=150.0 + length / 2)
                     for d in scene.debonds)
     bm = dataclasses.replace(scene.beam_model, core=1, elements=240)
-    a = dataclasses.replace(scene.analysis, locate_bifurcations=narrowed)
+    a = dataclasses.replace(scene.analysis, locate_critical_points=narrowed)
     if how == "allowance off":
         bm = dataclasses.replace(bm, settling_allowance=int(a.max_iterations))
     elif how == "fine":

@@ -172,10 +172,11 @@ class Analysis:
     max_increment: float | None = None
     tol: float = 1e-8
     max_iterations: int = 25
-    # narrow each step across a bifurcation by shorter steps inside it (a corrector each), so
-    # its load is located to ~0.5 % whatever the step (sandwich.solver.critical); off: located
-    # from the step's two states alone (free, second order in the step)
-    locate_bifurcations: bool = False
+    # narrow each step across a bifurcation or a load extremum by shorter steps inside it (a
+    # corrector each), so its load is located to ~0.5 % whatever the step
+    # (sandwich.solver.critical, sandwich.solver.extrema); off: located from the step's two
+    # states alone (free; second order in the step for a bifurcation, fourth for an extremum)
+    locate_critical_points: bool = False
 
 
 @dataclass(frozen=True)

@@ -430,9 +430,13 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
 
 def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     key = "analysis"
+    if isinstance(tbl, dict) and "locate_bifurcations" in tbl:  # its name until 2026-12-06
+        r.fail(_join(key, "locate_bifurcations"), "renamed 'locate_critical_points' (it "
+               "narrows load maxima and minima as well as bifurcations)")
+        tbl = {k: v for k, v in tbl.items() if k != "locate_bifurcations"}
     t = r.table(tbl, key, ("kind", "control", "until", "max_steps", "initial_increment",
                            "min_increment", "max_increment", "tol", "max_iterations",
-                           "locate_bifurcations"),
+                           "locate_critical_points"),
                 required=("kind", "until"))
     if t is None:
         return Analysis()
@@ -482,8 +486,8 @@ def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
                     until_value=until_value, until_load_factor=until_lf,
                     max_steps=max_steps or d.max_steps, initial_increment=inc, min_increment=lo,
                     max_increment=hi, tol=tol or d.tol, max_iterations=max_it or d.max_iterations,
-                    locate_bifurcations=r.boolean(t, "locate_bifurcations", key,
-                                                  default=d.locate_bifurcations))
+                    locate_critical_points=r.boolean(t, "locate_critical_points", key,
+                                                  default=d.locate_critical_points))
 
 
 def _beam_model(r: Reader, tbl: Any) -> BeamModelOptions:

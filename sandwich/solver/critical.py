@@ -61,8 +61,9 @@ MAX_ITERATIONS = 12
 #: Relative change of the crossed eigenvalue's Ritz value at which the iteration has converged
 #: (an error ε in μ at the two ends moves the located fraction t by at most ε t (1 − t) · 2).
 RITZ_TOL = 1e-4
-#: Equilibria solved inside a step across a bifurcation to narrow it (each one corrector of a
-#: shorter step from the state before), with ``PathOptions.locate_bifurcations``.
+#: Equilibria solved inside a step across a bifurcation (or a load extremum,
+#: :mod:`sandwich.solver.extrema`) to narrow it (each one corrector of a shorter step from the
+#: state before), with ``PathOptions.locate_critical_points``.
 MAX_SUBSTEPS = 3
 #: Narrowing stops once the located load factor moves by less than this (relative), or the
 #: bracket is narrower than it.

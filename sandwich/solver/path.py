@@ -174,15 +174,16 @@ class PathOptions:
         state before's: the path has come back through the unloaded state. Off by default (a
         snap-through may cross λ = 0 and come back); the beam's ``auto`` core levels set it on
         its reruns, which check a pass that never crossed it (docs/solver.md).
-    locate_bifurcations
-        Narrow a step across a bifurcation by equilibria solved inside it: shorter steps from
-        the state before (the path's own predictor and corrector, up to
+    locate_critical_points
+        Narrow a step across a bifurcation or a load extremum by equilibria solved inside it:
+        shorter steps from the state before (the path's own predictor and corrector, up to
         :data:`~sandwich.solver.critical.MAX_SUBSTEPS`), aimed where the crossed eigenvalue is
-        interpolated to be zero, until the located load moves by less than
-        :data:`~sandwich.solver.critical.LOCATE_RTOL`. They are not path states (the path is
-        the same with or without). Off by default: a bifurcation is then located within its
-        step from the eigenvalue at the step's two states (no corrector, second order in the
-        step; :meth:`_Follower._locate_crossing`).
+        interpolated to be zero (the load curve's slope, for an extremum), until the located
+        load moves by less than :data:`~sandwich.solver.critical.LOCATE_RTOL`. They are not
+        path states (the path is the same with or without). Off by default: the point is then
+        located within its step from the step's two states (no corrector; second order in the
+        step for a bifurcation, :meth:`_Follower._locate_crossing`; fourth for an extremum,
+        :meth:`_Follower._locate_extremum`). Named ``locate_bifurcations`` until 2026-12-06.
     """
 
     control: str = "load"
@@ -206,7 +207,7 @@ class PathOptions:
     target_tol: float = 1e-6
     target_accept: float = 1e-3
     stop_at_load_reversal: bool = False
-    locate_bifurcations: bool = False
+    locate_critical_points: bool = False
 
     @classmethod
     def from_analysis(cls, analysis: object, **overrides: object) -> PathOptions:
@@ -217,7 +218,7 @@ class PathOptions:
         """
         names = ("control", "until_load_factor", "until_probe", "until_value", "max_steps",
                  "initial_increment", "min_increment", "max_increment", "tol", "max_iterations",
-                 "locate_bifurcations")
+                 "locate_critical_points")
         return cls(**{**{n: getattr(analysis, n) for n in names}, **overrides})
 
     def __post_init__(self) -> None:
@@ -633,7 +634,7 @@ class _Follower:
         First from the two factorisations the step has
         (:func:`~sandwich.solver.critical.locate_crossing`: solves only, no tangent evaluated):
         where the crossed eigenvalue, linear along the step, is zero. Then, with
-        ``locate_bifurcations``, steps from ``last`` under the path's control (``t`` its load
+        ``locate_critical_points``, steps from ``last`` under the path's control (``t`` its load
         tangent), shorter than the step's increment h in the control's units (whether the step
         was the controller's, a target's, a rescue's or a kept bent one) and aimed at that
         point, narrow the bracket (regula falsi on the eigenvalue, Illinois' rule; the middle
@@ -655,7 +656,7 @@ class _Follower:
         hi = BracketEnd(1.0, state.load_factor, dict(state.probes),
                         None if c is None else c.mu_after)
         found = None if c is None else crossing_in(lo, hi, 0)
-        if not self.opt.locate_bifurcations or not h > 0.0 or abs(b - a) > MAX_CROSSINGS:
+        if not self.opt.locate_critical_points or not h > 0.0 or abs(b - a) > MAX_CROSSINGS:
             state.crossing = found
             return
         old_sign = 1.0 if b > a else -1.0
@@ -706,7 +707,7 @@ class _Follower:
         curve's tangent turns over within the step (in the plane the settling test measures
         bends in: the probe / its linear value at the target's load, λ / the target's load),
         the stationary point of λ's cubic Hermite interpolant in w. Then, with
-        ``locate_bifurcations``, steps from ``last`` under the path's control (``t`` its load
+        ``locate_critical_points``, steps from ``last`` under the path's control (``t`` its load
         tangent) aimed at that point narrow the bracket, each equilibrium's slope from one
         solve with its factorised tangent, as :meth:`_locate_crossing` narrows a bifurcation.
         """
@@ -729,7 +730,7 @@ class _Follower:
             return
         h = self._increment(last, state)
         retry = None
-        for _ in range(MAX_SUBSTEPS if self.opt.locate_bifurcations and h > 0.0 else 0):
+        for _ in range(MAX_SUBSTEPS if self.opt.locate_critical_points and h > 0.0 else 0):
             w = hi.f - lo.f
             f = retry if retry is not None else min(max(found[0], lo.f + SAFEGUARD * w),
                                                     hi.f - SAFEGUARD * w)

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def _scene(narrowed: bool, fine: bool = False):
     scene = load_scene(ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
     debonds = tuple(dataclasses.replace(d, start=120.0, end=180.0) for d in scene.debonds)
-    a = dataclasses.replace(scene.analysis, locate_bifurcations=narrowed)
+    a = dataclasses.replace(scene.analysis, locate_critical_points=narrowed)
     if fine:
         a = dataclasses.replace(a, control="displacement", until_value=-5.0, max_increment=0.05,
                                 initial_increment=0.05, max_steps=2000)

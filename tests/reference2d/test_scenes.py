@@ -79,12 +79,12 @@ def test_full_path_coarse(name):
 def test_fig5_bifurcation_is_located_within_its_step_and_the_path_is_unchanged():
     # the shared path follower locates the 2D model's bifurcation too (docs/solver.md): from
     # the step's two factorisations (the state before's MUMPS handle refactors it) and, with
-    # locate_bifurcations, by equilibria inside the step; reference: the 2D run's own states
+    # locate_critical_points, by equilibria inside the step; reference: the 2D run's own states
     # (the bracket) and the same path with narrowing off (bit for bit)
     scene = _short(load_scene(SCENES / f"{FIG5}.toml"), -5.0)
     plain = solve(scene, level="coarse")
     narrowed = solve(dataclasses.replace(scene, analysis=dataclasses.replace(
-        scene.analysis, locate_bifurcations=True)), level="coarse")
+        scene.analysis, locate_critical_points=True)), level="coarse")
     assert [r.load_factor for r in plain.history] == [r.load_factor for r in narrowed.history]
     p, = [lp for lp in plain.limit_points if lp.kind == "bifurcation"]
     n, = [lp for lp in narrowed.limit_points if lp.kind == "bifurcation"]

@@ -107,7 +107,7 @@ def _follow(system, step: float, locate: bool):
     lam_c = system.critical_load_factor
     opts = PathOptions(control="arc-length", until_load_factor=2.5 * lam_c, tol=1e-10,
                        initial_increment=step * lam_c, max_increment=step * lam_c,
-                       locate_bifurcations=locate)
+                       locate_critical_points=locate)
     return lam_c, follow_path(system, opts, ["x", "y"])
 
 
@@ -134,12 +134,12 @@ def test_the_scene_key_reaches_the_path_follower(tmp_path):
 
     src = (ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml").read_text()
     assert load_scene(ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml") \
-        .analysis.locate_bifurcations is False  # off by default
+        .analysis.locate_critical_points is False  # off by default
     path = tmp_path / "s.toml"
-    path.write_text(src.replace("[analysis]", "[analysis]\nlocate_bifurcations = true"))
+    path.write_text(src.replace("[analysis]", "[analysis]\nlocate_critical_points = true"))
     analysis = load_scene(path).analysis
-    assert analysis.locate_bifurcations is True
-    assert PathOptions.from_analysis(analysis).locate_bifurcations is True
+    assert analysis.locate_critical_points is True
+    assert PathOptions.from_analysis(analysis).locate_critical_points is True
 
 
 def test_a_load_maximum_inside_one_step_is_located_and_narrowed():
@@ -155,7 +155,7 @@ def test_a_load_maximum_inside_one_step_is_located_and_narrowed():
     def follow(locate):
         opts = PathOptions(control="displacement", until_probe="w", until_value=0.2,
                            initial_increment=0.2, max_increment=0.2, tol=1e-10,
-                           locate_bifurcations=locate)
+                           locate_critical_points=locate)
         return follow_path(VonMisesTruss(), opts, ["w"])
 
     plain, narrowed = follow(False), follow(True)

@@ -73,7 +73,7 @@ def test_the_knockdown_study_has_at_least_100_beam_cases():
     assert all(c.scene.beam_model.core == 1 for c in study.cases)  # the study's resolution
     # its [analysis] merged into every case: the capacities' critical loads are narrowed, and
     # the base scene's own [analysis] keys are kept
-    assert all(c.scene.analysis.locate_bifurcations for c in study.cases)
+    assert all(c.scene.analysis.locate_critical_points for c in study.cases)
     assert all(c.scene.analysis.until_probe == "w_top_mid" for c in study.cases)
 
 
