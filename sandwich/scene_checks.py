@@ -430,7 +430,7 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
 
 def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     key = "analysis"
-    if isinstance(tbl, dict) and "locate_bifurcations" in tbl:  # its name until 2026-12-06
+    if isinstance(tbl, dict) and "locate_bifurcations" in tbl:  # its name until 2026-12-05
         r.fail(_join(key, "locate_bifurcations"), "renamed 'locate_critical_points' (it "
                "narrows load maxima and minima as well as bifurcations)")
         tbl = {k: v for k, v in tbl.items() if k != "locate_bifurcations"}

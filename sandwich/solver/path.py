@@ -183,7 +183,7 @@ class PathOptions:
         path states (the path is the same with or without). Off by default: the point is then
         located within its step from the step's two states (no corrector; second order in the
         step for a bifurcation, :meth:`_Follower._locate_crossing`; fourth for an extremum,
-        :meth:`_Follower._locate_extremum`). Named ``locate_bifurcations`` until 2026-12-06.
+        :meth:`_Follower._locate_extremum`). Named ``locate_bifurcations`` until 2026-12-05.
     """
 
     control: str = "load"
