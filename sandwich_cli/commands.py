@@ -208,7 +208,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     _say(args, f"{args.model}: {len(sol.history)} converged step(s), final load factor "
          f"{sol.final_load_factor:.6g}, {sol.dofs} DOFs, {time.perf_counter() - t0:.1f} s")
     for lp in sol.limit_points:
-        _say(args, f"  {lp.kind} at step {lp.step}: load factor {lp.load_factor:.6g}")
+        where = (f"in step {lp.step} (between load factors {lp.between[0]:.6g} and "
+                 f"{lp.between[1]:.6g})" if lp.located_at is not None and lp.between
+                 else f"at step {lp.step}")
+        _say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
     _say(args, f"results in {out}/ (history.csv, profiles.csv, summary.json)")
     if not sol.converged:
         print(f"stopped before the target: {sol.message}", file=sys.stderr)

@@ -189,3 +189,20 @@ def test_ctrl_c_in_a_real_solve_keeps_the_converged_steps(tmp_path):
     assert summary["converged"] is False and "interrupted after step" in summary["message"]
     assert "G_warning" not in summary
     assert list(tmp_path.iterdir()) == [out]
+
+
+def test_a_critical_point_located_within_its_step_is_said_so(tmp_path, capsys):
+    # the default scene at the paper's core buckles inside its step 10 (docs/solver.md); the
+    # summary line names the step and the converged load factors either side of the point
+    path = tmp_path / "paper_core.toml"
+    path.write_text((ROOT / "scenes" / "default.toml").read_text() + "\n[beam_model]\ncore = 1\n")
+    out = tmp_path / "out"
+    assert main(["solve", str(path), "--model", "beam", "--out", str(out)]) == 0
+    said = [ln for ln in capsys.readouterr().out.splitlines() if "bifurcation in step" in ln]
+    assert len(said) == 1, said
+    summary = json.loads((out / "summary.json").read_text())
+    lp, = [p for p in summary["limit_points"] if p["kind"] == "bifurcation"]
+    low, high = lp["between_load_factors"]
+    assert low < lp["load_factor"] < high
+    assert said[0].strip() == (f"bifurcation in step {lp['step']} (between load factors "
+                               f"{low:.6g} and {high:.6g}): load factor {lp['load_factor']:.6g}")
