@@ -49,9 +49,13 @@ class LimitPoint:
     # bifurcation lies between the state before ``step`` and ``step``, an extremum between the
     # states either side of ``step``; the point is known to that resolution only
     between: tuple[float, float] | None = None
-    # a bifurcation located within its step (:mod:`sandwich.solver.critical`): the fraction of
-    # the step from the state before at which the tangent's crossed eigenvalue is zero, where
-    # ``load_factor`` and ``probes`` are interpolated; None: reported at the state ``step``
+    # a point located within the step that ends at the state ``step``: for a bifurcation
+    # (:mod:`sandwich.solver.critical`) the fraction of the step's size from the state before
+    # at which the tangent's crossed eigenvalue is zero, for a load extremum
+    # (:mod:`sandwich.solver.extrema`) the fraction of the step's change of the load curve's
+    # probe at which λ's interpolant is stationary; ``load_factor`` and ``probes`` are the
+    # located point's, ``between`` the step's (or the narrowed bracket's) load factors. None:
+    # reported at the state ``step``
     located_at: float | None = None
 
 

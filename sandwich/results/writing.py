@@ -8,7 +8,7 @@ A solve writes, as one set (:func:`write_solution`), into its folder:
   (interface normal stress at the core's top and bottom boundary, core shear at mid-core, MPa);
 - ``summary.json``: ``model, scene, converged, steps, final_load_factor, limit_points``
   (``kind, step, load_factor, probes``, ``between_load_factors``: the states that enclose
-  the point, and for a bifurcation located within its step ``located_at_step_fraction``),
+  the point, and for a point located within its step ``located_at_step_fraction``),
   ``wall_seconds, dofs`` and more;
 - ``fields.pvd`` + ``fields_NNNNN.vtu`` when the model returns 2D field frames (ParaView);
 - ``tip_tractions.csv`` when the scene (given) has debond tips: σzz and τ of the interface
