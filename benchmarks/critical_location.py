@@ -22,7 +22,6 @@ side of the crossing, which bound the reference's own error).
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
 import os
 import sys
@@ -31,6 +30,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout, not installed
+
+from location_table import reading_row, write_tables  # noqa: E402
 
 from sandwich.scene_file import load_scene  # noqa: E402
 
@@ -87,55 +88,11 @@ def main(argv: list[str] | None = None) -> int:
             plain = first_bifurcation(case(length, how, args.fine, False))
             narrow = ref if how == "fine" else first_bifurcation(case(length, how, args.fine,
                                                                       True))
-            row = {"length_mm": length, "path": how, "steps": plain["steps"],
-                   "seconds": round(plain["seconds"], 3),
-                   "seconds_narrowed": round(narrow["seconds"], 3),
-                   "step_low": plain.get("step_bracket", (None, None))[0],
-                   "step_high": plain.get("step_bracket", (None, None))[1],
-                   "at_state": plain.get("at_state"), "located": plain["load"],
-                   "narrowed": narrow["load"],
-                   "narrowed_low": narrow.get("bracket", (None, None))[0],
-                   "narrowed_high": narrow.get("bracket", (None, None))[1],
-                   "reference": ref["load"]}
-            for k in ("at_state", "located", "narrowed"):
-                row[f"{k}_error_pct"] = (None if row[k] is None or ref["load"] is None
-                                         else 100 * (row[k] - ref["load"]) / ref["load"])
-            rows.append(row)
-            print(length, how, {k: row[k] for k in ("steps", "at_state", "located", "narrowed",
-                                                     "reference")}, flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    with open(args.out / "critical_location.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-
-    def num(v, fmt="{:.2f}"):
-        return "—" if v is None else fmt.format(v)
-
-    lines = [
-        "# First bifurcation loads located within their step (benchmarks/critical_location.py)",
-        "",
-        __doc__.split("\n\n", 1)[1].strip(),
-        "",
-        f"Load average at start {load0[0]:.2f}, at end {os.getloadavg()[0]:.2f} (2 cores). "
-        f"Fine paths: displacement steps ≤ {args.fine} mm. Seconds: the beam run in process, "
-        "without / with narrowing.",
-        "",
-        "| debond (mm) | path | steps | step (λ) | at state | error | located | error "
-        "| narrowed | error | its bracket | seconds |",
-        "|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---|---|",
-    ]
-    for r in rows:
-        lines.append(
-            f"| {r['length_mm']:g} | {r['path']} | {r['steps']} | "
-            f"{num(r['step_low'])} – {num(r['step_high'])} "
-            f"| {num(r['at_state'])} | {num(r['at_state_error_pct'], '{:+.2f} %')} "
-            f"| {num(r['located'])} | {num(r['located_error_pct'], '{:+.2f} %')} "
-            f"| {num(r['narrowed'])} | {num(r['narrowed_error_pct'], '{:+.2f} %')} "
-            f"| {num(r['narrowed_low'])} – {num(r['narrowed_high'])} "
-            f"| {r['seconds']:.2f} / {r['seconds_narrowed']:.2f} |")
-    (args.out / "critical_location.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
-    print(f"wrote {args.out / 'critical_location.md'}")
+            rows.append(reading_row({"length_mm": length}, how, plain, narrow, ref))
+    write_tables(rows, args.out, "critical_location",
+                 "First bifurcation loads located within their step "
+                 "(benchmarks/critical_location.py)", __doc__.split("\n\n", 1)[1].strip(),
+                 ("debond (mm)", "---:", lambda r: f"{r['length_mm']:g}"), args.fine, load0)
     return 0
 
 

@@ -26,7 +26,6 @@ the path there. Errors are against the fine path's narrowed value.
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
 import os
 import sys
@@ -35,6 +34,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout, not installed
+
+from location_table import reading_row, write_tables  # noqa: E402
 
 from sandwich.scene_file import load_scene  # noqa: E402
 
@@ -110,63 +111,16 @@ def main(argv: list[str] | None = None) -> int:
             plain = first_maximum(followed(scene, how, args.fine, False))
             narrow = ref if how == "fine" else first_maximum(followed(scene, how, args.fine,
                                                                       True))
-            row = {"case": name, "path": how, "steps": plain["steps"],
-                   "seconds": round(plain["seconds"], 3),
-                   "seconds_narrowed": round(narrow["seconds"], 3),
-                   "step_low": plain.get("step_bracket", (None, None))[0],
-                   "step_high": plain.get("step_bracket", (None, None))[1],
-                   "at_state": plain.get("at_state"), "located": plain["load"],
-                   "narrowed": narrow["load"],
-                   "narrowed_low": narrow.get("bracket", (None, None))[0],
-                   "narrowed_high": narrow.get("bracket", (None, None))[1],
-                   "reference": ref["load"],
-                   "stopped": "" if plain["reached"] else " ".join(plain["message"].split())}
-            for k in ("at_state", "located", "narrowed"):
-                row[f"{k}_error_pct"] = (None if row[k] is None or ref["load"] is None
-                                         else 100 * (row[k] - ref["load"]) / ref["load"])
-            rows.append(row)
-            print(name, how, {k: row[k] for k in ("steps", "at_state", "located", "narrowed",
-                                                   "reference")}, flush=True)
-            if plain["load"] is None:
-                print("   no maximum:", plain["message"], flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    with open(args.out / "maximum_location.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-
-    def num(v, fmt="{:.2f}"):
-        return "—" if v is None else fmt.format(v)
-
-    lines = [
-        "# First load maxima located within their step (benchmarks/maximum_location.py)",
-        "",
-        __doc__.split("\n\n", 1)[1].strip(),
-        "",
-        f"Load average at start {load0[0]:.2f}, at end {os.getloadavg()[0]:.2f} (2 cores). "
-        f"Fine paths: displacement steps ≤ {args.fine} mm. Seconds: the beam run in process, "
-        "without / with narrowing.",
-        "",
-        "| case | path | steps | step (λ) | at state | error | located | error "
-        "| narrowed | error | its bracket | seconds |",
-        "|---|---|---:|---|---:|---:|---:|---:|---:|---:|---|---|",
-    ]
-    for r in rows:
-        lines.append(
-            f"| {r['case']} | {r['path']} | {r['steps']} | "
-            f"{num(r['step_low'])} – {num(r['step_high'])} "
-            f"| {num(r['at_state'])} | {num(r['at_state_error_pct'], '{:+.3f} %')} "
-            f"| {num(r['located'])} | {num(r['located_error_pct'], '{:+.3f} %')} "
-            f"| {num(r['narrowed'])} | {num(r['narrowed_error_pct'], '{:+.3f} %')} "
-            f"| {num(r['narrowed_low'])} – {num(r['narrowed_high'])} "
-            f"| {r['seconds']:.2f} / {r['seconds_narrowed']:.2f} |")
+            rows.append({**reading_row({"case": name}, how, plain, narrow, ref),
+                         "stopped": "" if plain["reached"] else " ".join(plain["message"].split())})
     stopped = [r for r in rows if r["stopped"]]
-    if stopped:
-        lines += ["", "Paths that stopped short of their target (their maximum is the last "
-                  "one they sampled):", ""]
-        lines += [f"- {r['case']}, {r['path']}: {r['stopped']}" for r in stopped]
-    (args.out / "maximum_location.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
-    print(f"wrote {args.out / 'maximum_location.md'}")
+    after = (["", "Paths that stopped short of their target (their maximum is the last one "
+              "they sampled):", ""] + [f"- {r['case']}, {r['path']}: {r['stopped']}"
+                                       for r in stopped]) if stopped else []
+    write_tables(rows, args.out, "maximum_location",
+                 "First load maxima located within their step (benchmarks/maximum_location.py)",
+                 __doc__.split("\n\n", 1)[1].strip(), ("case", "---", lambda r: r["case"]),
+                 args.fine, load0, error_digits=3, after=after)
     return 0
 
 
