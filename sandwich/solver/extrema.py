@@ -8,17 +8,21 @@ between 555.9 and 706.8; docs/beam_speed.md).
 Each converged state already has the load tangent t = K⁻¹ f_ref (the next step's predictor), so
 the load curve's slope there comes free: along the equilibrium path K du = f_ref dλ, so the
 curve's probe w = c·u moves as dw/dλ = c·t (:attr:`sandwich.solver.path.PathState.probe_rate`).
-A step A → B passes a load extremum where the curve's tangent in the (w, λ) plane turns its λ
-component over while its w component keeps its sense (a turning point of w — a snap-back — is
-the other way round and is not an extremum of λ). The tangents are oriented forward along the
-step (an acute angle with its chord in the scaled plane, as the arc-length predictor's sign).
+A step A → B passes a load extremum where the path's tangent (t, 1) turns its λ component over
+while its w component (c·t) keeps the sense of the step's change of w (a turning point of w —
+a snap-back — is the other way round and is not an extremum of λ). Each state's tangent is
+oriented forward along the step in the path's own space: its sense is that of
+t·Δu + ψ² Δλ over the step's change (Δu, Δλ), as the retrace guard measures turns.
 
 Over such a step λ is taken as the cubic Hermite interpolant of λ(w) through both states' values
 and slopes dλ/dw = 1/(c·t); its stationary point inside the step is the located extremum. The
 error in its load factor is fourth order in the step where λ(w) is smooth (the interpolant's),
 against the second order of the extreme state (`tests/solver/test_solver_extremum_location.py`
-measures both on the von Mises truss, closed form). The other probes are interpolated linearly
-in w between the states.
+measures both on the von Mises truss, closed form). Where w is about to turn at an end, λ(w)
+is not smooth and the cubic swells: a located maximum above the meeting point of the two end
+tangent lines (a minimum below it) is refused — a concave top lies below it — and the extreme
+state is reported as before. The other probes are interpolated linearly in w between the
+states.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
+from scipy.optimize import brentq
 
 __all__ = ["Extremum", "SlopeEnd", "hermite_extremum", "located_in", "turns_over"]
 
@@ -37,7 +41,7 @@ class Extremum:
 
     ``kind`` is ``"max"`` or ``"min"``; ``fraction`` the located point's fraction of the step's
     change of the curve's probe; ``load_factor`` and ``probes`` the located point's;
-    ``between`` the load factors of the step's two states.
+    ``between`` the load factors of the step's two states (or of the narrowed bracket's ends).
     """
 
     kind: str
@@ -47,32 +51,25 @@ class Extremum:
     between: tuple[float, float]
 
 
-def turns_over(dw: float, dlam: float, rate_a: float, rate_b: float, w_scale: float,
-               lam_scale: float) -> str | None:
+def turns_over(dw: float, rate_a: float, rate_b: float, sense_a: float,
+               sense_b: float) -> str | None:
     """Which load extremum a step passes: ``"max"``, ``"min"`` or None.
 
-    ``dw``, ``dlam``: the step's change of the probe and of λ; ``rate_a``, ``rate_b``: dw/dλ
-    at its two states; ``w_scale``, ``lam_scale``: the units of the curve's plane. Each state's
-    tangent (rate, 1) is turned forward (acute with the chord); a max is a tangent whose λ
-    component goes from rising to falling while its w component keeps its sense (a min the
-    other way). None where the tangents are not finite, the chord has no w component, or w
-    turns too.
+    ``dw``: the step's change of the probe; ``rate_a``, ``rate_b``: dw/dλ at its two ends;
+    ``sense_a``, ``sense_b``: the sense (±1) in which the tangent (t, 1) at each end points
+    forward along the step. A max is a forward tangent whose λ component goes from rising to
+    falling while its w component (sense × rate) moves w the way the step does at both ends (a
+    min the other way). None where a rate is not finite, the step does not move w, or w turns
+    within it.
     """
     if not (math.isfinite(rate_a) and math.isfinite(rate_b)) or dw == 0.0 \
-            or not (w_scale > 0.0 and lam_scale > 0.0):
+            or sense_a == 0.0 or sense_b == 0.0:
         return None
-    chord = (dw / w_scale, dlam / lam_scale)
-
-    def forward(rate: float) -> tuple[float, float]:
-        t = (rate / w_scale, 1.0 / lam_scale)
-        return t if t[0] * chord[0] + t[1] * chord[1] >= 0.0 else (-t[0], -t[1])
-
-    ta, tb = forward(rate_a), forward(rate_b)
-    if ta[0] * tb[0] <= 0.0:  # w turns within the step (or a tangent is parallel to λ): no
-        return None
-    if ta[1] > 0.0 > tb[1]:
+    if sense_a * rate_a * dw <= 0.0 or sense_b * rate_b * dw <= 0.0:
+        return None  # w turns within the step (or a tangent does not move it)
+    if sense_a > 0.0 > sense_b:
         return "max"
-    if ta[1] < 0.0 < tb[1]:
+    if sense_a < 0.0 < sense_b:
         return "min"
     return None
 
@@ -83,8 +80,10 @@ def hermite_extremum(dw: float, lam_a: float, lam_b: float, rate_a: float,
 
     λ(x) through (0, ``lam_a``) and (1, ``lam_b``) with dλ/dx = ``dw``/rate at either end
     (x the fraction of the step's probe change ``dw``, rate = dw/dλ). The slopes must have
-    opposite signs (:func:`turns_over`); the quadratic λ'(x) then has exactly one root in
-    (0, 1). None where it cannot be found (a rate of zero).
+    opposite signs (:func:`turns_over`); λ'(x) then has exactly one root in (0, 1). None where
+    a rate is zero, or where the stationary value lies beyond the meeting point of the end
+    tangent lines (above it for a maximum, below for a minimum: the cubic has swollen where w
+    is about to turn, and the point is not trusted).
     """
     if rate_a == 0.0 or rate_b == 0.0:
         return None
@@ -94,27 +93,30 @@ def hermite_extremum(dw: float, lam_a: float, lam_b: float, rate_a: float,
     d = lam_b - lam_a
     c2 = 3.0 * d - 2.0 * s0 - s1
     c3 = -2.0 * d + s0 + s1
-    roots = np.roots([3.0 * c3, 2.0 * c2, s0]) if c3 != 0.0 or c2 != 0.0 else np.empty(0)
-    inside = [float(r.real) for r in np.atleast_1d(roots)
-              if abs(r.imag) <= 1e-12 * max(1.0, abs(r.real)) and 0.0 < r.real < 1.0]
-    if not inside:
+    x = brentq(lambda r: s0 + r * (2.0 * c2 + 3.0 * c3 * r), 0.0, 1.0, xtol=1e-14, rtol=1e-14)
+    lam = lam_a + x * (s0 + x * (c2 + x * c3))
+    # the end tangents λ_a + s0 x and λ_b + s1 (x − 1) meet at x_m (s0 − s1 ≠ 0: opposite signs)
+    x_m = (d - s1) / (s0 - s1)
+    lam_m = lam_a + s0 * x_m
+    if (lam - lam_m) * (1.0 if s0 > 0.0 else -1.0) > 1e-12 * max(abs(lam), abs(lam_m)):
         return None
-    x = min(inside, key=lambda r: abs(s0 + 2.0 * c2 * r + 3.0 * c3 * r * r))
-    return x, lam_a + x * (s0 + x * (c2 + x * c3))
+    return x, lam
 
 
 @dataclass(frozen=True)
 class SlopeEnd:
     """A converged equilibrium on a step across a load extremum, with its slope.
 
-    ``f`` its fraction of the step's size from the state before, its load factor, probes and
-    dw/dλ (``rate``) of the curve's probe there.
+    ``f`` its fraction of the step's size from the state before, its load factor, probes,
+    dw/dλ (``rate``) of the curve's probe there and the sense (±1) in which its tangent points
+    forward along the step.
     """
 
     f: float
     load_factor: float
     probes: dict[str, float]
     rate: float
+    sense: float
 
 
 def located_in(lo: SlopeEnd, hi: SlopeEnd, name: str) -> tuple[float, float] | None:

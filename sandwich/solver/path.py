@@ -508,7 +508,7 @@ class _Follower:
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
             self._locate_crossing(state, last, fac_before, fac, t)
             state.probe_rate = self._probe_rate(t_next)
-            self._locate_extremum(state, last, t)
+            self._locate_extremum(state, last, t, t_next)
             t = t_next
             done = self._target_reached()
             if done:
@@ -700,68 +700,77 @@ class _Follower:
         rate = self.dot(self.c[self.rate_probe], t)
         return float(rate) if math.isfinite(rate) else None
 
-    def _locate_extremum(self, state: PathState, last: PathState, t: np.ndarray) -> None:
+    def _locate_extremum(self, state: PathState, last: PathState, t: np.ndarray,
+                         t_next: np.ndarray) -> None:
         """Locate a load extremum within the step ``last`` → ``state`` (:mod:`~.extrema`).
 
-        From the two states' loads, probes and slopes dw/dλ alone (no solve): where the load
-        curve's tangent turns over within the step (in the plane the settling test measures
-        bends in: the probe / its linear value at the target's load, λ / the target's load),
-        the stationary point of λ's cubic Hermite interpolant in w. Then, with
-        ``locate_critical_points``, steps from ``last`` under the path's control (``t`` its load
-        tangent) aimed at that point narrow the bracket, each equilibrium's slope from one
-        solve with its factorised tangent, as :meth:`_locate_crossing` narrows a bifurcation.
+        From the two states' loads, probes and load tangents alone (``t`` at ``last``,
+        ``t_next`` at ``state``; no solve): where the path's tangent, oriented forward along the
+        step (the sense of t·Δu + ψ²Δλ), turns its λ component over while w keeps moving the
+        step's way, the stationary point of λ's cubic Hermite interpolant in w. Then, with
+        ``locate_critical_points``, steps from ``last`` under the path's control aimed at that
+        point (the middle of the bracket where the interpolant is refused) narrow the bracket,
+        each equilibrium's tangent from one solve with its factorisation, as
+        :meth:`_locate_crossing` narrows a bifurcation.
         """
         name, qa, qb = self.rate_probe, last.probe_rate, state.probe_rate
         if name is None or qa is None or qb is None:
             return
-        wa, wb = last.probes[name], state.probes[name]
-        lam_scale = abs(self.lam_est) or 1.0
-        w_scale = abs(self.states[0].probe_rate or 0.0) * lam_scale
+        du, dlam = state.u - last.u, state.load_factor - last.load_factor
+
+        def sense(tangent: np.ndarray) -> float:
+            return float(np.sign(self.dot(tangent, du) + self.psi**2 * dlam))
 
         def kind_between(a: SlopeEnd, b: SlopeEnd) -> str | None:
-            return turns_over(b.probes[name] - a.probes[name], b.load_factor - a.load_factor,
-                              a.rate, b.rate, w_scale, lam_scale)
+            return turns_over(b.probes[name] - a.probes[name], a.rate, b.rate, a.sense, b.sense)
 
-        lo = SlopeEnd(0.0, last.load_factor, dict(last.probes), qa)
-        hi = SlopeEnd(1.0, state.load_factor, dict(state.probes), qb)
+        lo = SlopeEnd(0.0, last.load_factor, dict(last.probes), qa, sense(t))
+        hi = SlopeEnd(1.0, state.load_factor, dict(state.probes), qb, sense(t_next))
         kind = kind_between(lo, hi)
-        found = None if kind is None else located_in(lo, hi, name)
-        if found is None:
+        if kind is None:
             return
+        found = located_in(lo, hi, name)
         h = self._increment(last, state)
         retry = None
         for _ in range(MAX_SUBSTEPS if self.opt.locate_critical_points and h > 0.0 else 0):
             w = hi.f - lo.f
-            f = retry if retry is not None else min(max(found[0], lo.f + SAFEGUARD * w),
+            aim = found[0] if found is not None else 0.5 * (lo.f + hi.f)
+            f = retry if retry is not None else min(max(aim, lo.f + SAFEGUARD * w),
                                                     hi.f - SAFEGUARD * w)
             trial = self._inside_step(f * h, last, t)
-            rate = None
+            tangent = None
             if trial is not None:
                 try:
-                    rate = self._probe_rate(np.asarray(trial.factorization.solve(self.f_ref),
-                                                       dtype=float))
+                    tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
                 except RECOVERABLE_ERRORS:
-                    rate = None
+                    tangent = None
+            rate = None if tangent is None else self._probe_rate(tangent)
             retry = None if rate is not None else lo.f + 0.5 * (f - lo.f)
             if rate is None:
                 continue
-            mid = SlopeEnd(f, trial.load_factor, self.probes(trial.u), rate)
+            mid = SlopeEnd(f, trial.load_factor, self.probes(trial.u), rate, sense(tangent))
+            if not min(lo.probes[name], hi.probes[name]) < mid.probes[name] < \
+                    max(lo.probes[name], hi.probes[name]):
+                break  # not between the bracket's ends in w: keep the bracket
             if kind_between(lo, mid) == kind:
-                hi = mid
+                lo_next, hi_next = lo, mid
             elif kind_between(mid, hi) == kind:
-                lo = mid
-            else:  # the try's slope fits neither side: keep what the bracket had
+                lo_next, hi_next = mid, hi
+            else:  # the try's tangent fits neither side: keep the bracket
                 break
-            previous, found = found, located_in(lo, hi, name)
-            if found is None:
-                found = previous
-                break
+            located = located_in(lo_next, hi_next, name)
+            lo, hi = lo_next, hi_next
+            previous, found = found, located
+            if found is None or previous is None:
+                continue
             if abs(found[1] - previous[1]) <= LOCATE_RTOL * abs(found[1]):
                 break
+        if found is None:
+            return
         f, lam = found
         s = (f - lo.f) / (hi.f - lo.f)  # linear in the probe between the bracket's ends
         probes = {n: v + s * (hi.probes[n] - v) for n, v in lo.probes.items()}
-        x = (probes[name] - wa) / (wb - wa)
+        x = (probes[name] - last.probes[name]) / (state.probes[name] - last.probes[name])
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
 
     def _inside_step(self, h: float, last: PathState, t: np.ndarray) -> _Trial | None:

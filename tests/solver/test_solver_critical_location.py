@@ -169,4 +169,7 @@ def test_a_load_maximum_inside_one_step_is_located_and_narrowed():
     assert n.kind == "max"
     assert n.load_factor == pytest.approx(lam_max, rel=1e-5)
     assert n.probes["w"] == pytest.approx(w_max, rel=1e-3)
+    # the fraction of the step's probe change (w from 0 to 0.2)
+    assert p.located_at == pytest.approx(w_max / 0.2, rel=0.02)
+    assert n.located_at == pytest.approx(w_max / 0.2, rel=1e-3)
     assert abs(n.load_factor - lam_max) < 0.01 * abs(p.load_factor - lam_max)
