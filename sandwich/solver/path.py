@@ -506,9 +506,9 @@ class _Follower:
                 t_next = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
-            self._locate_crossing(state, last, fac_before, fac, t)
             state.probe_rate = self._probe_rate(t_next)
             self._locate_extremum(state, last, t, t_next)
+            self._locate_crossing(state, last, fac_before, fac, t)
             t = t_next
             done = self._target_reached()
             if done:
@@ -640,7 +640,9 @@ class _Follower:
         point, narrow the bracket (regula falsi on the eigenvalue, Illinois' rule; the middle
         where an end's eigenvalue is unknown; after a try that fails, half as far from the
         bracket's lower end). Their equilibria are not path states, and the path's own
-        settings (contact-limited corrections) are left as they were.
+        settings (contact-limited corrections) are left as they were. Not narrowed: a change
+        by one on a step with a located load extremum (:meth:`_locate_extremum`, run first),
+        which :func:`~sandwich.solver.limits.find_limit_points` reads as that extremum's.
         """
         a, b = last.negative_pivots, state.negative_pivots
         if a is None or b is None or a == b:
@@ -656,7 +658,11 @@ class _Follower:
         hi = BracketEnd(1.0, state.load_factor, dict(state.probes),
                         None if c is None else c.mu_after)
         found = None if c is None else crossing_in(lo, hi, 0)
-        if not self.opt.locate_critical_points or not h > 0.0 or abs(b - a) > MAX_CROSSINGS:
+        # a change by one on a step with a located load extremum is that extremum's (a
+        # limit point makes the tangent singular; limits.py reads it so): no tries for it
+        explained = state.extremum is not None and abs(b - a) == 1
+        if not self.opt.locate_critical_points or not h > 0.0 or abs(b - a) > MAX_CROSSINGS \
+                or explained:
             state.crossing = found
             return
         old_sign = 1.0 if b > a else -1.0
