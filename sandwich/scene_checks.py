@@ -65,13 +65,19 @@ class Reader:
         self.problems.append(Problem(self.fname, key, reason))
 
     def table(self, value: Any, key: str, allowed: tuple[str, ...],
-              required: tuple[str, ...] = ()) -> dict[str, Any] | None:
-        """Check that ``value`` is a table with only ``allowed`` keys and all ``required`` ones."""
+              required: tuple[str, ...] = (),
+              renamed: dict[str, str] | None = None) -> dict[str, Any] | None:
+        """Check that ``value`` is a table with only ``allowed`` keys and all ``required`` ones.
+
+        ``renamed`` maps a key's former name to its name now: the old one is refused with it.
+        """
         if not isinstance(value, dict):
             self.fail(key, f"expected a table, got {_typename(value)}")
             return None
         for k in value:
-            if k not in allowed:
+            if renamed and k in renamed:
+                self.fail(_join(key, k), f"renamed '{renamed[k]}'")
+            elif k not in allowed:
                 near = difflib.get_close_matches(k, allowed, n=1, cutoff=0.6)
                 hint = (f" (did you mean '{near[0]}'?)" if near
                         else f" (allowed: {', '.join(allowed)})")
@@ -430,14 +436,12 @@ def _probes(r: Reader, arr: Any, L: float | None) -> list[Probe]:
 
 def _analysis(r: Reader, tbl: Any, probes: list[Probe]) -> Analysis:
     key = "analysis"
-    if isinstance(tbl, dict) and "locate_bifurcations" in tbl:  # its name until 2026-12-05
-        r.fail(_join(key, "locate_bifurcations"), "renamed 'locate_critical_points' (it "
-               "narrows load maxima and minima as well as bifurcations)")
-        tbl = {k: v for k, v in tbl.items() if k != "locate_bifurcations"}
     t = r.table(tbl, key, ("kind", "control", "until", "max_steps", "initial_increment",
                            "min_increment", "max_increment", "tol", "max_iterations",
                            "locate_critical_points"),
-                required=("kind", "until"))
+                required=("kind", "until"),
+                # until 2026-12-05 (it narrows load extrema as well now)
+                renamed={"locate_bifurcations": "locate_critical_points"})
     if t is None:
         return Analysis()
     kind = r.choice(t, "kind", key, ANALYSIS_KINDS, default=Analysis.kind)
