@@ -114,6 +114,10 @@ SETTLING_BEND = math.radians(2.0)
 #: most this many times the increment the step-size controller asks for then
 #: (:meth:`_Follower._bent_half`).
 HALF_REACH = 1.25
+#: The walk along the branch a probe rescue jumped from (:meth:`_Follower._walk_rescued_branch`):
+#: its correctors at most, and its smallest probe step as a fraction of its first.
+WALK_TRIES = 12
+WALK_MIN_FRACTION = 1.0 / 16.0
 
 
 @dataclass
@@ -508,6 +512,8 @@ class _Follower:
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
             state.probe_rate = self._probe_rate(t_next)
             self._locate_extremum(state, last, t, t_next)
+            if self.rescues and self.rescues[-1] == step:
+                self._walk_rescued_branch(state, last, t)
             self._locate_crossing(state, last, fac_before, fac, t)
             t = t_next
             done = self._target_reached()
@@ -778,6 +784,107 @@ class _Follower:
         probes = {n: v + s * (hi.probes[n] - v) for n, v in lo.probes.items()}
         x = (probes[name] - last.probes[name]) / (state.probes[name] - last.probes[name])
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
+
+    def _walk_rescued_branch(self, state: PathState, last: PathState, t: np.ndarray) -> None:
+        """The furthest load on the branch a probe rescue jumped from: a bound of its extremum.
+
+        A probe rescue (:meth:`_probe_rescue`) is taken where the arc collapsed; the branch
+        from ``last`` may end close ahead (the debonded face snaps: fig. 6 as shipped). Where λ
+        still rose at ``last`` towards the target and the rescue landed lower (or fell and
+        landed higher: a minimum), that branch's top lies inside the rescued step, and neither
+        its states nor their slopes see it: both tangents rise, the one at ``state`` on the
+        branch it jumped to. A rescue that carried on the way λ went is not walked (fig. 7 c4:
+        the arc collapsed on a branch that goes on rising, its contact pairs opening and
+        closing).
+
+        The branch is walked from ``last`` under control of the until probe: steps of half the
+        probe change of the step before ``last`` (at most 1/8 of the rescued step's), each from
+        the walk's last equilibrium with its load tangent as predictor; a step whose corrector
+        fails or leaves the branch (:meth:`_walk_try`), or whose λ turns back (the top is
+        passed), is halved; the walk ends below :data:`WALK_MIN_FRACTION` of the first step or
+        after :data:`WALK_TRIES` correctors. Its highest (lowest) equilibrium, where it lies
+        beyond both of the step's states, is the step's located extremum: a bound of the
+        branch's top from below (above), the top lying within the last refused step of it in
+        the probe. The walk's equilibria are not path states; the path's settings are left as
+        they were.
+        """
+        name, rate = self.opt.until_probe, last.probe_rate
+        if state.extremum is not None or name is None or name != self.rate_probe \
+                or rate is None or rate == 0.0 or len(self.states) < 3:
+            return
+        v0, v1 = last.probes[name], state.probes[name]
+        before = self.states[-3].probes[name]
+        if v1 == v0:
+            return
+        direction = math.copysign(1.0, v1 - v0)
+        sign = math.copysign(1.0, direction / rate)  # dλ = dw / (dw/dλ): +1 rising, a max
+        if sign * (state.load_factor - last.load_factor) >= 0.0:
+            return  # the rescue carried on the way λ went: no top left behind (fig. 7 c4)
+        first = min(0.5 * abs(v0 - before), abs(v1 - v0) / 8.0)
+        if not first > 0.0:
+            return
+        failed_once, sigma = self.failed_once, self.sigma
+        u, lam, tangent, v = last.u, last.load_factor, t, v0
+        best = None
+        delta, tries = first, 0
+        while tries < WALK_TRIES and delta >= WALK_MIN_FRACTION * first:
+            goal = v + direction * delta
+            if direction * (v1 - goal) <= 0.0:
+                break
+            tries += 1
+            trial = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots)
+            if trial is None or sign * (trial.load_factor - lam) < 0.0:
+                delta *= 0.5
+                continue
+            try:
+                tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
+            except RECOVERABLE_ERRORS:
+                break
+            u, lam, v, best = trial.u, trial.load_factor, goal, trial
+        self.failed_once, self.sigma = failed_once, sigma
+        ends = (last.load_factor, state.load_factor)
+        if best is None or sign * best.load_factor <= max(sign * e for e in ends):
+            return
+        probes = self.probes(best.u)
+        state.extremum = Extremum("max" if sign > 0 else "min",
+                                  (probes[name] - v0) / (v1 - v0), best.load_factor, probes,
+                                  ends)
+
+    def _walk_try(self, name: str, goal: float, u: np.ndarray, lam: float, t: np.ndarray,
+                  negative_pivots: int | None) -> _Trial | None:
+        """One corrector of :meth:`_walk_rescued_branch` to ``value(name) = goal`` (None: off it).
+
+        The predictor is the load tangent ``t`` at ``(u, λ)``; the rising test stops a diverging
+        corrector early, and one that needs more than ``desired_iterations`` fails (the walk's
+        steps are short: on fig. 6 those that converge take 3-6 iterations, while those that do
+        not ran to the 25 allowed). Refused: a failed corrector, another inertia than
+        ``negative_pivots``, a corrector that moved more than ``max_correction_ratio`` × the
+        predictor from it (a jump to another branch), an inadmissible state.
+        """
+        c = self.c[name]
+        ct = self.dot(c, t)
+        if ct == 0.0 or not math.isfinite(ct):
+            return None
+        dlam = (goal - self.dot(c, u)) / ct
+        try:
+            res = self._correct(u + dlam * t, lam + dlam, ProbeConstraint(c, goal, self.dot),
+                                dataclasses.replace(self._newton_settings(DIVERGENCE_RISES),
+                                                    max_iterations=self.opt.desired_iterations),
+                                u, lam)
+        except RECOVERABLE_ERRORS:
+            return None
+        if not res.converged or res.factorization is None:
+            return None
+        neg = res.factorization.negative_pivots
+        if negative_pivots is not None and neg != negative_pivots:
+            return None
+        reach = self.wnorm(dlam * t, dlam)
+        if self.wnorm(res.u - u - dlam * t, res.load_factor - lam - dlam) > \
+                self.opt.max_correction_ratio * reach:
+            return None
+        if self.admissible is not None and self.admissible(res.u):
+            return None
+        return _Trial(res.u, res.load_factor, res.iterations, res.factorization, res.rises)
 
     def _inside_step(self, h: float, last: PathState, t: np.ndarray) -> _Trial | None:
         """A step of ``h`` from ``last`` whose equilibrium is not a path state (or None).

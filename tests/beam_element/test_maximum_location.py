@@ -49,3 +49,30 @@ def test_a_maximum_inside_a_long_step_is_located_and_narrowed_to_the_fine_paths_
     assert abs(p.load_factor - ref) < 0.01 * ref  # located from the slopes: +0.30 % (measured)
     assert abs(p.load_factor - ref) < 0.25 * (ref - top)
     assert abs(n.load_factor - ref) < 1e-4 * ref  # narrowed: 2e-10 (measured)
+
+
+def test_the_top_a_probe_rescue_jumps_over_is_bounded_by_walking_its_branch():
+    # fig. 6 as shipped: at λ 1952.4 the arc collapses where the debonded face is about to
+    # snap, and the probe rescue steps to λ 1915.3 on the branch beyond, both of its tangents
+    # rising. Reference: the same model (its core levels frozen) in displacement steps of at
+    # most 0.2 mm, stalling where that branch ends (the same end state in steps of 0.05 and
+    # 0.1 mm: λ 1976.79 at w_bottom −9.6470 mm, to 1e-11; the tangent stays regular up to it).
+    scene = load_scene(ROOT / "scenes" / "paper-fig6-top-debond-20-load-bottom.toml")
+    shipped = solve_run(scene)
+    assert "under control of w_bottom_mid" in shipped.solution.message
+    fine_analysis = dataclasses.replace(scene.analysis, control="displacement",
+                                        max_increment=0.2, initial_increment=0.2,
+                                        max_steps=500)
+    fine = solve_run(dataclasses.replace(scene, analysis=fine_analysis),
+                     model_options={"core_level": shipped.model.element_levels})
+    top = max(fine.states, key=lambda s: s.load_factor)
+    ref = top.load_factor
+    p = _maximum(shipped)
+    before = max(s.load_factor for s in shipped.states if s.step < p.step)
+    assert before < (1 - 0.01) * ref  # the state before the jump: 1.2 % below (measured)
+    assert max(p.between) == before and 0.0 < p.located_at < 1.0
+    # an equilibrium of the branch: a bound from below, 0.05 % below the end (measured)
+    assert p.load_factor <= ref * (1 + 1e-9)
+    assert p.load_factor > ref * (1 - 2e-3)
+    w = "w_bottom_mid"
+    assert top.probes[w] <= p.probes[w] < shipped.states[p.step - 1].probes[w]

@@ -10,6 +10,7 @@ step jumps it; the probe step does.
 """
 
 import numpy as np
+import pytest
 from solver_toys import ToySystem
 
 from sandwich.solver import PathOptions, follow_path
@@ -59,3 +60,46 @@ def test_without_the_rescue_the_same_path_stops_and_says_why():
     assert not result.reached_target
     assert "min_increment" in result.message
     assert w[-1] <= 0.50
+
+
+class DroppedSpring(GappedSpring):
+    """The gapped spring whose branch beyond the band carries ``drop`` less load.
+
+    ``f(w) = k w`` up to ``lo``, ``k w − drop`` from ``hi`` on: the branch the path loads
+    along ends at the band with its top ``λ = k lo`` (closed form), and the rescue lands on a
+    branch below it.
+    """
+
+    def __init__(self, lo: float, hi: float, drop: float, k: float = 2.0) -> None:
+        super().__init__(lo, hi, k)
+        self.drop = drop
+
+    def internal_force(self, u):
+        return self.k * u - (self.drop if u[0] >= self.hi else 0.0)
+
+
+def test_the_top_of_the_branch_the_rescue_jumped_from_is_walked_to():
+    # The rescued step's two states do not see the branch's top (the first is short of it,
+    # the second on the branch below), so the walk from the first state under control of w
+    # bounds it: from below (a state on the branch), within the walk's resolution — a sixteenth
+    # of its first step, half the probe change of the step before (closed form λ = k lo).
+    system = DroppedSpring(lo=0.50, hi=0.56, drop=0.3)
+    opts = PathOptions(control="arc-length", until_probe="w", until_value=1.0, tol=1e-10,
+                       initial_increment=0.15, max_increment=0.15)
+    result = follow_path(system, opts, ["w"])
+    assert result.reached_target, result.message
+    (rescued,) = [int(s) for s in result.message.split("step(s) ")[-1].rstrip(")").split(",")]
+    w = np.array([s.probes["w"] for s in result.states])
+    lam = np.array([s.load_factor for s in result.states])
+    assert not np.any((w > 0.50) & (w < 0.56))
+    top = system.k * system.lo
+    (peak,) = [lp for lp in result.limit_points if lp.kind == "max"]
+    assert peak.step == rescued
+    assert lam[rescued - 1] < peak.load_factor <= top  # above both states, never above the top
+    first = 0.5 * (w[rescued - 1] - w[rescued - 2])
+    assert top - peak.load_factor <= system.k * first / 8.0
+    assert peak.probes["w"] == pytest.approx(peak.load_factor / system.k, rel=1e-9)
+    assert peak.between == (lam[rescued - 1], lam[rescued])
+    assert 0.0 < peak.located_at < 1.0
+    # the walk's equilibria are not path states: every state on the closed form
+    np.testing.assert_allclose(lam, system.k * w - np.where(w >= 0.56, 0.3, 0.0), rtol=1e-9)
