@@ -118,6 +118,13 @@ HALF_REACH = 1.25
 #: its correctors at most, and its smallest probe step as a fraction of its first.
 WALK_TRIES = 12
 WALK_MIN_FRACTION = 1.0 / 16.0
+#: A walk that reaches the branch's end with its slope dw/dλ at least this fraction of the one
+#: it started with ended abruptly (no turn of w ahead, where dw/dλ would fall to 0) ...
+WALK_SLOPE_KEPT = 0.5
+#: ... and its end is a top where the rescued state lies below the end's tangent line,
+#: extrapolated to its probe value, by more than this fraction of the end's load (load lost);
+#: or below the walk's top itself by as much.
+WALK_LOSS = 1e-3
 
 
 @dataclass
@@ -786,27 +793,37 @@ class _Follower:
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
 
     def _walk_rescued_branch(self, state: PathState, last: PathState, t: np.ndarray) -> None:
-        """The furthest load on the branch a probe rescue jumped from: a bound of its extremum.
+        """The furthest load on the branch a probe rescue jumped from: a bound of its top.
 
         A probe rescue (:meth:`_probe_rescue`) is taken where the arc collapsed; the branch
-        from ``last`` may end close ahead (the debonded face snaps: fig. 6 as shipped). Where λ
-        still rose at ``last`` towards the target and the rescue landed lower (or fell and
-        landed higher: a minimum), that branch's top lies inside the rescued step, and neither
-        its states nor their slopes see it: both tangents rise, the one at ``state`` on the
-        branch it jumped to. A rescue that carried on the way λ went is not walked (fig. 7 c4:
-        the arc collapsed on a branch that goes on rising, its contact pairs opening and
-        closing).
+        from ``last`` may end close ahead (the debonded face snaps: fig. 6 as shipped). Its top
+        then lies inside the rescued step, and neither the step's states nor their slopes see
+        it: both tangents rise, the one at ``state`` on the branch the rescue jumped to.
 
-        The branch is walked from ``last`` under control of the until probe: steps of half the
-        probe change of the step before ``last`` (at most 1/8 of the rescued step's), each from
-        the walk's last equilibrium with its load tangent as predictor; a step whose corrector
-        fails or leaves the branch (:meth:`_walk_try`), or whose λ turns back (the top is
-        passed), is halved; the walk ends below :data:`WALK_MIN_FRACTION` of the first step or
-        after :data:`WALK_TRIES` correctors. Its highest (lowest) equilibrium, where it lies
-        beyond both of the step's states, is the step's located extremum: a bound of the
-        branch's top from below (above), the top lying within the last refused step of it in
-        the probe. The walk's equilibria are not path states; the path's settings are left as
-        they were.
+        The branch is walked from ``last`` under control of the until probe, the way λ rose at
+        ``last`` towards the target (fell: a minimum): steps of half the probe change of the
+        step before ``last`` (at most 1/8 of the rescued step's), each from the walk's last
+        equilibrium with its load tangent as predictor; a step whose corrector fails or leaves
+        the branch (:meth:`_walk_try`), or whose λ turns back, is halved; the walk ends below
+        :data:`WALK_MIN_FRACTION` of the first step (the branch's end), at the rescued state's
+        probe value or after :data:`WALK_TRIES` correctors. Its highest (lowest) equilibrium
+        is the step's located extremum — a bound of the top from below (above), the top lying
+        within the last refused step of it in the probe — where the walk rose above ``last``
+        and one of these shows that load was lost beyond it:
+
+        * the rescued state lies below it by more than :data:`WALK_LOSS` of its load (fig. 6
+          as shipped, 1915.3 after 1975.8);
+        * λ turned back on the branch (a smooth top, passed by a walk step);
+        * the walk reached the branch's end with its slope dw/dλ still at least
+          :data:`WALK_SLOPE_KEPT` of the one at ``last`` (no turn of w ahead), and the rescued
+          state lies below that end's tangent line, extrapolated to its probe value, by more
+          than :data:`WALK_LOSS` of the end's load (the knock-down study's 10-mm debond at
+          x = 110, whose rescue went straight to the target: the same top, 2060.0, as its
+          mirror image at x = 190, whose rescue landed below it).
+
+        Otherwise nothing is reported (fig. 7 c4: its arc collapsed on a branch that goes on
+        rising, its contact pairs opening and closing; the walk's 12 steps all rose). The walk's
+        equilibria are not path states; the path's settings are left as they were.
         """
         name, rate = self.opt.until_probe, last.probe_rate
         if state.extremum is not None or name is None or name != self.rate_probe \
@@ -818,33 +835,47 @@ class _Follower:
             return
         direction = math.copysign(1.0, v1 - v0)
         sign = math.copysign(1.0, direction / rate)  # dλ = dw / (dw/dλ): +1 rising, a max
-        if sign * (state.load_factor - last.load_factor) >= 0.0:
-            return  # the rescue carried on the way λ went: no top left behind (fig. 7 c4)
         first = min(0.5 * abs(v0 - before), abs(v1 - v0) / 8.0)
         if not first > 0.0:
             return
         failed_once, sigma = self.failed_once, self.sigma
-        u, lam, tangent, v = last.u, last.load_factor, t, v0
+        u, lam, tangent, v, rate_end = last.u, last.load_factor, t, v0, rate
         best = None
         delta, tries = first, 0
-        while tries < WALK_TRIES and delta >= WALK_MIN_FRACTION * first:
+        ended = turned = False  # the halving ran out at the branch's end; λ turned back on it
+        while tries < WALK_TRIES:
+            if delta < WALK_MIN_FRACTION * first:
+                ended = True
+                break
             goal = v + direction * delta
             if direction * (v1 - goal) <= 0.0:
                 break
             tries += 1
             trial = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots)
-            if trial is None or sign * (trial.load_factor - lam) < 0.0:
+            back = trial is not None and sign * (trial.load_factor - lam) < 0.0
+            turned = turned or back
+            if trial is None or back:
                 delta *= 0.5
                 continue
             try:
                 tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS:
                 break
-            u, lam, v, best = trial.u, trial.load_factor, goal, trial
+            u, lam, v, best, rate_end = trial.u, trial.load_factor, goal, trial, \
+                self._probe_rate(tangent)
         self.failed_once, self.sigma = failed_once, sigma
-        ends = (last.load_factor, state.load_factor)
-        if best is None or sign * best.load_factor <= max(sign * e for e in ends):
+        if best is None or sign * (best.load_factor - last.load_factor) <= 0.0:
             return
+        lost = WALK_LOSS * abs(best.load_factor)
+        dropped = sign * (best.load_factor - state.load_factor) > lost
+        abrupt = False
+        if ended and rate_end is not None and rate_end / rate >= WALK_SLOPE_KEPT:
+            # the rescued state below the end's tangent line by more than WALK_LOSS: load lost
+            on_line = best.load_factor + (v1 - v) / rate_end
+            abrupt = sign * (on_line - state.load_factor) > lost
+        if not (dropped or turned or abrupt):
+            return
+        ends = (last.load_factor, state.load_factor)
         probes = self.probes(best.u)
         state.extremum = Extremum("max" if sign > 0 else "min",
                                   (probes[name] - v0) / (v1 - v0), best.load_factor, probes,

@@ -78,12 +78,14 @@ class DroppedSpring(GappedSpring):
         return self.k * u - (self.drop if u[0] >= self.hi else 0.0)
 
 
-def test_the_top_of_the_branch_the_rescue_jumped_from_is_walked_to():
+@pytest.mark.parametrize("drop", [0.3, 0.05])
+def test_the_top_of_the_branch_the_rescue_jumped_from_is_walked_to(drop):
     # The rescued step's two states do not see the branch's top (the first is short of it,
-    # the second on the branch below), so the walk from the first state under control of w
-    # bounds it: from below (a state on the branch), within the walk's resolution — a sixteenth
-    # of its first step, half the probe change of the step before (closed form λ = k lo).
-    system = DroppedSpring(lo=0.50, hi=0.56, drop=0.3)
+    # the second on the branch beyond: below it with drop 0.3, above it with 0.05), so the walk
+    # from the first state under control of w bounds it: from below (a state on the branch),
+    # within the walk's resolution — a sixteenth of its first step, half the probe change of
+    # the step before (closed form λ = k lo).
+    system = DroppedSpring(lo=0.50, hi=0.56, drop=drop)
     opts = PathOptions(control="arc-length", until_probe="w", until_value=1.0, tol=1e-10,
                        initial_increment=0.15, max_increment=0.15)
     result = follow_path(system, opts, ["w"])
@@ -95,11 +97,26 @@ def test_the_top_of_the_branch_the_rescue_jumped_from_is_walked_to():
     top = system.k * system.lo
     (peak,) = [lp for lp in result.limit_points if lp.kind == "max"]
     assert peak.step == rescued
-    assert lam[rescued - 1] < peak.load_factor <= top  # above both states, never above the top
+    assert lam[rescued - 1] < peak.load_factor <= top  # above the state before, never the top
+    assert (lam[rescued] < peak.load_factor) == (drop > 0.2)  # the landing: below or above
     first = 0.5 * (w[rescued - 1] - w[rescued - 2])
     assert top - peak.load_factor <= system.k * first / 8.0
     assert peak.probes["w"] == pytest.approx(peak.load_factor / system.k, rel=1e-9)
     assert peak.between == (lam[rescued - 1], lam[rescued])
     assert 0.0 < peak.located_at < 1.0
     # the walk's equilibria are not path states: every state on the closed form
-    np.testing.assert_allclose(lam, system.k * w - np.where(w >= 0.56, 0.3, 0.0), rtol=1e-9)
+    np.testing.assert_allclose(lam, system.k * w - np.where(w >= 0.56, drop, 0.0), rtol=1e-9)
+
+
+@pytest.mark.parametrize("drop", [0.0, -0.2])
+def test_a_rescue_onto_a_branch_that_lost_no_load_reports_no_top(drop):
+    # The branch ends at the band (the walk's halving runs out there, its slope unchanged), but
+    # the path beyond lies on the branch's tangent line (0.0: the same spring, only its states
+    # in the band refused) or above it (−0.2): no load lost, no top to report — the walk's end
+    # is not taken for one. (The path itself: as without the walk, on the closed form.)
+    system = DroppedSpring(lo=0.50, hi=0.56, drop=drop)
+    opts = PathOptions(control="arc-length", until_probe="w", until_value=1.0, tol=1e-10,
+                       initial_increment=0.15, max_increment=0.15)
+    result = follow_path(system, opts, ["w"])
+    assert result.reached_target and "under control of w" in result.message
+    assert result.limit_points == []
