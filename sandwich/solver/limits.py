@@ -5,7 +5,7 @@
   the path follower locates it within the step before or after that state from the load
   curve's slopes (:mod:`sandwich.solver.extrema`, a state's ``extremum``; in a step the probe
   rescue took across a snap, by walking the branch it left to its end:
-  :meth:`sandwich.solver.path._Follower._walk_rescued_branch`), and it is reported
+  :meth:`sandwich.solver.path._Follower._walk_branch_left`), and it is reported
   there: ``located_at`` the fraction of that step's probe change, ``between`` that step's two
   load factors. Without a located one it is reported at the extreme state (exact only to the
   step resolution: the two increments' loads are its ``between``). An extremum located inside

@@ -114,14 +114,21 @@ SETTLING_BEND = math.radians(2.0)
 #: most this many times the increment the step-size controller asks for then
 #: (:meth:`_Follower._bent_half`).
 HALF_REACH = 1.25
-#: The walk along the branch a probe rescue jumped from (:meth:`_Follower._walk_rescued_branch`):
-#: its correctors at most, and its smallest probe step as a fraction of its first.
-WALK_TRIES = 12
+#: An arc step whose corrector takes back more than this fraction of its predictor's load
+#: change, with the tangent's inertia unchanged, may have jumped to another branch past a snap:
+#: the branch it left is walked as a rescued step's is (:meth:`_Follower._jumped`) ...
+JUMP_LOSS = 0.3
+#: ... or whose corrector moved further than this fraction of its predictor's length (the
+#: face's snapped shape appears in the correction, at little loss of load).
+JUMP_CORRECTION = 0.25
+#: The walk along the branch a step jumped from (:meth:`_Follower._walk_branch_left`): its
+#: correctors at most, and its smallest probe step as a fraction of its first.
+WALK_TRIES = 16
 WALK_MIN_FRACTION = 1.0 / 16.0
 #: A walk that reaches the branch's end with its slope dw/dλ at least this fraction of the one
 #: it started with ended abruptly (no turn of w ahead, where dw/dλ would fall to 0) ...
 WALK_SLOPE_KEPT = 0.5
-#: ... and its end is a top where the rescued state lies below the end's tangent line,
+#: ... and its end is a top where the step's end state lies below the end's tangent line,
 #: extrapolated to its probe value, by more than this fraction of the end's load (load lost);
 #: or below the walk's top itself by as much.
 WALK_LOSS = 1e-3
@@ -308,6 +315,8 @@ class _Trial:
     factorization: Factorization
     rises: int = 0  # the corrector's longest run of rises above its first residual
     increment_iterations: int | None = None  # until its increment test first passed
+    predicted_load_change: float | None = None  # the predictor's Δλ (an arc-length step's)
+    correction_ratio: float | None = None  # the corrector's distance / the predictor's length
 
 
 def _cosine(a: tuple[float, float], b: tuple[float, float]) -> float | None:
@@ -519,8 +528,8 @@ class _Follower:
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
             state.probe_rate = self._probe_rate(t_next)
             self._locate_extremum(state, last, t, t_next)
-            if self.rescues and self.rescues[-1] == step:
-                self._walk_rescued_branch(state, last, t)
+            if (self.rescues and self.rescues[-1] == step) or self._jumped(last, trial):
+                self._walk_branch_left(state, last, t)
             self._locate_crossing(state, last, fac_before, fac, t)
             t = t_next
             done = self._target_reached()
@@ -792,37 +801,61 @@ class _Follower:
         x = (probes[name] - last.probes[name]) / (state.probes[name] - last.probes[name])
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
 
-    def _walk_rescued_branch(self, state: PathState, last: PathState, t: np.ndarray) -> None:
-        """The furthest load on the branch a probe rescue jumped from: a bound of its top.
+    def _jumped(self, last: PathState, trial: _Trial) -> bool:
+        """Whether an arc step may have landed on another branch past a snap.
 
-        A probe rescue (:meth:`_probe_rescue`) is taken where the arc collapsed; the branch
-        from ``last`` may end close ahead (the debonded face snaps: fig. 6 as shipped). Its top
-        then lies inside the rescued step, and neither the step's states nor their slopes see
-        it: both tangents rise, the one at ``state`` on the branch the rescue jumped to.
+        Its corrector moved further than :data:`JUMP_CORRECTION` × its predictor's length, or
+        took back more than :data:`JUMP_LOSS` of the predictor's load change, the tangent's
+        inertia the same at both ends (a crossing is :meth:`_locate_crossing`'s). Measured on
+        the knock-down study's off-centre debonds, whose faces snap at about their clamped-strip
+        Euler loads: 0.29-0.97 and −0.10..−0.45 on the steps that jump the snap, at most 0.1
+        and ±0.1 on the steps of either branch. Large also where the path bends at a load
+        maximum (whose extremum, located first, skips the walk) or on a step that only bends:
+        the walk then finds no end and reports nothing, at the cost of its correctors.
+        """
+        p, ratio = trial.predicted_load_change, trial.correction_ratio
+        if p is None or p == 0.0 or not math.isfinite(p) or ratio is None:
+            return False
+        neg = last.negative_pivots
+        if neg is None or trial.factorization.negative_pivots != neg:
+            return False
+        return ratio > JUMP_CORRECTION or (trial.load_factor - last.load_factor - p) / p < \
+            -JUMP_LOSS
+
+    def _walk_branch_left(self, state: PathState, last: PathState, t: np.ndarray) -> None:
+        """The furthest load on the branch a step jumped from: a bound of its top.
+
+        A probe rescue (:meth:`_probe_rescue`) is taken where the arc collapsed, and an arc step
+        may converge past a snap (:meth:`_jumped`); in both the branch from ``last`` may end
+        inside the step (the debonded face snaps: fig. 6 as shipped, the knock-down study's
+        off-centre debonds). Its top then lies inside the step, and neither the step's states
+        nor their slopes see it: both tangents rise, the one at ``state`` on the branch the step
+        landed on.
 
         The branch is walked from ``last`` under control of the until probe, the way λ rose at
         ``last`` towards the target (fell: a minimum): steps of half the probe change of the
-        step before ``last`` (at most 1/8 of the rescued step's), each from the walk's last
+        step before ``last`` (at most 1/4 of this step's), each from the walk's last
         equilibrium with its load tangent as predictor; a step whose corrector fails or leaves
-        the branch (:meth:`_walk_try`), or whose λ turns back, is halved; the walk ends below
-        :data:`WALK_MIN_FRACTION` of the first step (the branch's end), at the rescued state's
-        probe value or after :data:`WALK_TRIES` correctors. Its highest (lowest) equilibrium
-        is the step's located extremum — a bound of the top from below (above), the top lying
-        within the last refused step of it in the probe — where the walk rose above ``last``
-        and one of these shows that load was lost beyond it:
+        the branch (:meth:`_walk_try`), or whose λ turns back, is halved, and one past
+        ``state``'s probe value goes half way to it; the walk ends below
+        :data:`WALK_MIN_FRACTION` of the first step (the branch's end) or after
+        :data:`WALK_TRIES` correctors. Its highest (lowest) equilibrium (``last`` itself where
+        the branch ended before the walk's first equilibrium) is the step's located extremum —
+        a bound of the top from below (above), the top lying within the last refused step of
+        it in the probe — where one of these shows that load was lost beyond it:
 
-        * the rescued state lies below it by more than :data:`WALK_LOSS` of its load (fig. 6
-          as shipped, 1915.3 after 1975.8);
+        * ``state`` lies below it by more than :data:`WALK_LOSS` of its load (fig. 6 as
+          shipped, 1915.3 after 1975.8);
         * λ turned back on the branch (a smooth top, passed by a walk step);
         * the walk reached the branch's end with its slope dw/dλ still at least
-          :data:`WALK_SLOPE_KEPT` of the one at ``last`` (no turn of w ahead), and the rescued
-          state lies below that end's tangent line, extrapolated to its probe value, by more
-          than :data:`WALK_LOSS` of the end's load (the knock-down study's 10-mm debond at
+          :data:`WALK_SLOPE_KEPT` of the one at ``last`` (no turn of w ahead), and ``state``
+          lies below that end's tangent line, extrapolated to its probe value, by more than
+          :data:`WALK_LOSS` of the end's load (the knock-down study's 10-mm debond at
           x = 110, whose rescue went straight to the target: the same top, 2060.0, as its
           mirror image at x = 190, whose rescue landed below it).
 
         Otherwise nothing is reported (fig. 7 c4: its arc collapsed on a branch that goes on
-        rising, its contact pairs opening and closing; the walk's 12 steps all rose). The walk's
+        rising, its contact pairs opening and closing; the walk's steps all rose). The walk's
         equilibria are not path states; the path's settings are left as they were.
         """
         name, rate = self.opt.until_probe, last.probe_rate
@@ -835,7 +868,7 @@ class _Follower:
             return
         direction = math.copysign(1.0, v1 - v0)
         sign = math.copysign(1.0, direction / rate)  # dλ = dw / (dw/dλ): +1 rising, a max
-        first = min(0.5 * abs(v0 - before), abs(v1 - v0) / 8.0)
+        first = min(0.5 * abs(v0 - before), abs(v1 - v0) / 4.0)
         if not first > 0.0:
             return
         failed_once, sigma = self.failed_once, self.sigma
@@ -848,8 +881,9 @@ class _Follower:
                 ended = True
                 break
             goal = v + direction * delta
-            if direction * (v1 - goal) <= 0.0:
-                break
+            if direction * (v1 - goal) <= 0.0:  # not past the step's end: half the way to it
+                delta = 0.5 * abs(v1 - v)
+                continue
             tries += 1
             trial = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots)
             back = trial is not None and sign * (trial.load_factor - lam) < 0.0
@@ -864,26 +898,28 @@ class _Follower:
             u, lam, v, best, rate_end = trial.u, trial.load_factor, goal, trial, \
                 self._probe_rate(tangent)
         self.failed_once, self.sigma = failed_once, sigma
-        if best is None or sign * (best.load_factor - last.load_factor) <= 0.0:
+        if best is None and not ended:
             return
-        lost = WALK_LOSS * abs(best.load_factor)
-        dropped = sign * (best.load_factor - state.load_factor) > lost
+        # no step of the walk converged but the branch ended: it ends within its smallest
+        # step of ``last`` itself (knock-down 40 mm at x = 70: 0.06 % below the fine path's top)
+        top, top_u = (best.load_factor, best.u) if best is not None else (lam, last.u)
+        lost = WALK_LOSS * abs(top)
+        dropped = sign * (top - state.load_factor) > lost
         abrupt = False
         if ended and rate_end is not None and rate_end / rate >= WALK_SLOPE_KEPT:
-            # the rescued state below the end's tangent line by more than WALK_LOSS: load lost
-            on_line = best.load_factor + (v1 - v) / rate_end
+            # the step's end state below the end's tangent line by more than WALK_LOSS
+            on_line = top + (v1 - v) / rate_end
             abrupt = sign * (on_line - state.load_factor) > lost
         if not (dropped or turned or abrupt):
             return
         ends = (last.load_factor, state.load_factor)
-        probes = self.probes(best.u)
+        probes = self.probes(top_u)
         state.extremum = Extremum("max" if sign > 0 else "min",
-                                  (probes[name] - v0) / (v1 - v0), best.load_factor, probes,
-                                  ends)
+                                  max(0.0, (probes[name] - v0) / (v1 - v0)), top, probes, ends)
 
     def _walk_try(self, name: str, goal: float, u: np.ndarray, lam: float, t: np.ndarray,
                   negative_pivots: int | None) -> _Trial | None:
-        """One corrector of :meth:`_walk_rescued_branch` to ``value(name) = goal`` (None: off it).
+        """One corrector of :meth:`_walk_branch_left` to ``value(name) = goal`` (None: off it).
 
         The predictor is the load tangent ``t`` at ``(u, λ)``; the rising test stops a diverging
         corrector early, and one that needs more than ``desired_iterations`` fails (the walk's
@@ -1097,8 +1133,10 @@ class _Follower:
             why = self.admissible(res.u)
             if why:
                 return None, f"{INADMISSIBLE}: {why}"
+        arc = opt.control == "arc-length"
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization,
-                      res.rises, res.increment_iterations), "converged"
+                      res.rises, res.increment_iterations, dlam if arc else None,
+                      dist / pred_len if arc and pred_len > 0.0 else None), "converged"
 
     def _newton_settings(self, rises: int = 0, limit: bool | None = None) -> NewtonSettings:
         """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far.

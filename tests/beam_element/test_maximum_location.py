@@ -9,10 +9,14 @@ its extreme state lies 2.3 % below the top.
 """
 
 import dataclasses
+import math
 from pathlib import Path
+
+import pytest
 
 from beam_element import run as solve_run
 from sandwich.scene_file import load_scene
+from studies.study_file import load_study
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -76,3 +80,30 @@ def test_the_top_a_probe_rescue_jumps_over_is_bounded_by_walking_its_branch():
     assert p.load_factor > ref * (1 - 2e-3)
     w = "w_bottom_mid"
     assert top.probes[w] <= p.probes[w] < shipped.states[p.step - 1].probes[w]
+
+
+@pytest.mark.parametrize(("index", "until"), [(91, -2.0), (57, -3.5), (89, -2.0)])
+def test_a_face_snap_a_step_jumps_over_is_found_by_walking_the_branch(index, until):
+    # The knock-down study's off-centre debonds (91: 40 mm at x = 110; 57: 25 mm at x = 90;
+    # 89: 40 mm at x = 70): the debonded face snaps away from the core under the bending
+    # compression, and one step lands on the snapped branch (91: an arc step, λ 159.5 → 182.4,
+    # below the top; 57: the kept half of a bent step, 472.7 → 548.0, 0.1 % below it; 89: the
+    # probe rescue from λ 288.10, 0.001 mm short of the top, to 305.6). Reference: the same
+    # case in displacement steps of 0.01 mm, which stall at the branch's end (its top). Closed
+    # form for scale: the clamped-strip Euler load of the debonded face, π² E t²/(3 L²) × b t d
+    # over the moment arm x/2 (196.0, 613.4, 308.1): the tops are 0.98, 0.89, 0.94 of it.
+    case = load_study(ROOT / "studies" / "shipped" / "fig5-knockdown.toml").cases[index]
+    path = solve_run(case.scene)
+    fine_analysis = dataclasses.replace(case.scene.analysis, control="displacement",
+                                        max_increment=0.01, initial_increment=0.01,
+                                        until_value=until, max_steps=1000)
+    fine = solve_run(dataclasses.replace(case.scene, analysis=fine_analysis))
+    ref = max(s.load_factor for s in fine.states)
+    assert "no convergence" in fine.solution.message  # it stalls at the snap, short of `until`
+    first = path.solution.limit_points[0]
+    assert first.kind == "max" and first.located_at is not None
+    assert ref * (1 - 5e-3) < first.load_factor <= ref * (1 + 1e-9)
+    E, t, b, d, span = 27420.0, 0.5, 60.0, 25.5, case.values["length"]
+    arm = min(case.values["centre"], 300.0 - case.values["centre"]) / 2.0
+    euler = math.pi**2 * E * t**2 / (3.0 * span**2) * b * t * d / arm
+    assert 0.85 * euler < first.load_factor < euler
