@@ -3,9 +3,10 @@
 - A *limit point* is a local extremum of λ along the path. The states show it where the
   increments Δλ before and after a state have opposite signs (zero increments are skipped);
   the path follower locates it within the step before or after that state from the load
-  curve's slopes (:mod:`sandwich.solver.extrema`, a state's ``extremum``; in a step the probe
-  rescue took across a snap, by walking the branch it left to its end:
-  :meth:`sandwich.solver.path._Follower._walk_branch_left`), and it is reported
+  curve's slopes (:mod:`sandwich.solver.extrema`, a state's ``extremum``; in a step that
+  jumped a snap — a probe rescue, or an arc step whose corrector moved far — by walking the
+  branch it left to its end: :meth:`sandwich.solver.path._Follower._walk_branch_left`), and it
+  is reported
   there: ``located_at`` the fraction of that step's probe change, ``between`` that step's two
   load factors. Without a located one it is reported at the extreme state (exact only to the
   step resolution: the two increments' loads are its ``between``). An extremum located inside
@@ -49,13 +50,20 @@ class _State(Protocol):
     negative_pivots: int | None
 
 
-def _located_extremum(states: Sequence[_State], steps: Sequence[int], kind: str) -> int | None:
-    """The state among ``steps`` whose step has a located extremum of ``kind`` (the top one)."""
+def _located_extremum(states: Sequence[_State], steps: Sequence[int], kind: str,
+                      extreme: float) -> int | None:
+    """The state among ``steps`` whose step has a located extremum of ``kind`` (the top one).
+
+    Only one at or beyond the extreme state's load ``extreme``: a top found by walking the
+    branch a step left lies below the states after it where the path regained more (it is
+    another, earlier extremum, reported in its own step).
+    """
+    sign = 1.0 if kind == "max" else -1.0
     found = [m for m in steps if 0 < m < len(states)
-             and (e := getattr(states[m], "extremum", None)) is not None and e.kind == kind]
+             and (e := getattr(states[m], "extremum", None)) is not None and e.kind == kind
+             and sign * e.load_factor >= sign * extreme]
     if not found:
         return None
-    sign = 1.0 if kind == "max" else -1.0
     return max(found, key=lambda m: sign * states[m].extremum.load_factor)
 
 
@@ -92,7 +100,7 @@ def find_limit_points(states: Sequence[_State]) -> list[LimitPoint]:
             s = states[k]
             after = int(j1) + 1  # the state that ends the next non-zero increment
             limit_at.add(k)
-            m = _located_extremum(states, (k, after), kind)
+            m = _located_extremum(states, (k, after), kind, float(lam[k]))
             if m is not None and m not in taken:  # located within the step before or after k
                 taken.add(m)
                 found.append(_from_extremum(states[m]))

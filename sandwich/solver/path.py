@@ -315,8 +315,6 @@ class _Trial:
     factorization: Factorization
     rises: int = 0  # the corrector's longest run of rises above its first residual
     increment_iterations: int | None = None  # until its increment test first passed
-    predicted_load_change: float | None = None  # the predictor's Δλ (an arc-length step's)
-    correction_ratio: float | None = None  # the corrector's distance / the predictor's length
 
 
 def _cosine(a: tuple[float, float], b: tuple[float, float]) -> float | None:
@@ -528,7 +526,7 @@ class _Follower:
                 return self.finish(False, f"step {step + 1}: load tangent failed ({exc})")
             state.probe_rate = self._probe_rate(t_next)
             self._locate_extremum(state, last, t, t_next)
-            if (self.rescues and self.rescues[-1] == step) or self._jumped(last, trial):
+            if (self.rescues and self.rescues[-1] == step) or self._jumped(last, state, t):
                 self._walk_branch_left(state, last, t)
             self._locate_crossing(state, last, fac_before, fac, t)
             t = t_next
@@ -801,26 +799,36 @@ class _Follower:
         x = (probes[name] - last.probes[name]) / (state.probes[name] - last.probes[name])
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
 
-    def _jumped(self, last: PathState, trial: _Trial) -> bool:
-        """Whether an arc step may have landed on another branch past a snap.
+    def _jumped(self, last: PathState, state: PathState, t: np.ndarray) -> bool:
+        """Whether the step ``last`` → ``state`` may have landed on another branch past a snap.
 
-        Its corrector moved further than :data:`JUMP_CORRECTION` × its predictor's length, or
-        took back more than :data:`JUMP_LOSS` of the predictor's load change, the tangent's
-        inertia the same at both ends (a crossing is :meth:`_locate_crossing`'s). Measured on
-        the knock-down study's off-centre debonds, whose faces snap at about their clamped-strip
-        Euler loads: 0.29-0.97 and −0.10..−0.45 on the steps that jump the snap, at most 0.1
-        and ±0.1 on the steps of either branch. Large also where the path bends at a load
-        maximum (whose extremum, located first, skips the walk) or on a step that only bends:
-        the walk then finds no end and reports nothing, at the cost of its correctors.
+        The step's change Δ = (Δu, Δλ) against the path's tangent (t, 1) at ``last`` (``t``
+        its load tangent), in the arc's norm: Δ leaves the tangent's line by more than
+        :data:`JUMP_CORRECTION` × its projection on it, or its load change falls short of the
+        projection's by more than :data:`JUMP_LOSS` of it, the tangent's inertia the same at
+        both ends (a crossing is :meth:`_locate_crossing`'s). For an arc step the first is the
+        corrector's distance from the predictor over the predictor's length; measured on the
+        knock-down study's off-centre debonds, whose faces snap at about their clamped-strip
+        Euler loads: 0.29-0.97 and −0.10..−0.45 on the steps that jump the snap, at most 0.1 and
+        ±0.1 on the steps of either branch. Any step is measured so (a kept bent half, a
+        target's). Large also where the path bends at a load maximum (whose extremum, located
+        first, skips the walk) or on a step that only bends: the walk then finds no end, or an
+        end without a loss of load, and reports nothing, at the cost of its correctors.
         """
-        p, ratio = trial.predicted_load_change, trial.correction_ratio
-        if p is None or p == 0.0 or not math.isfinite(p) or ratio is None:
-            return False
         neg = last.negative_pivots
-        if neg is None or trial.factorization.negative_pivots != neg:
+        if neg is None or state.negative_pivots != neg or self.opt.control != "arc-length":
             return False
-        return ratio > JUMP_CORRECTION or (trial.load_factor - last.load_factor - p) / p < \
-            -JUMP_LOSS
+        du, dlam = state.u - last.u, state.load_factor - last.load_factor
+        along = self.wnorm(t, 1.0)
+        if not along > 0.0 or not math.isfinite(along):
+            return False
+        p = (self.dot(du, t) + self.psi**2 * dlam) / along  # Δ's projection on the tangent
+        length = self.wnorm(du, dlam)
+        if p == 0.0 or not math.isfinite(p):
+            return False
+        off = math.sqrt(max(length**2 - p**2, 0.0)) / abs(p)
+        predicted = p / along  # the tangent's load change over that projection
+        return off > JUMP_CORRECTION or (dlam - predicted) / predicted < -JUMP_LOSS
 
     def _walk_branch_left(self, state: PathState, last: PathState, t: np.ndarray) -> None:
         """The furthest load on the branch a step jumped from: a bound of its top.
@@ -835,27 +843,40 @@ class _Follower:
         The branch is walked from ``last`` under control of the until probe, the way λ rose at
         ``last`` towards the target (fell: a minimum): steps of half the probe change of the
         step before ``last`` (at most 1/4 of this step's), each from the walk's last
-        equilibrium with its load tangent as predictor; a step whose corrector fails or leaves
-        the branch (:meth:`_walk_try`), or whose λ turns back, is halved, and one past
-        ``state``'s probe value goes half way to it; the walk ends below
-        :data:`WALK_MIN_FRACTION` of the first step (the branch's end) or after
-        :data:`WALK_TRIES` correctors. Its highest (lowest) equilibrium (``last`` itself where
-        the branch ended before the walk's first equilibrium) is the step's located extremum —
-        a bound of the top from below (above), the top lying within the last refused step of
-        it in the probe — where one of these shows that load was lost beyond it:
+        equilibrium with its load tangent as predictor, its correctors as the path's at the
+        walk's start with at most ``desired_iterations`` iterations (:meth:`_walk_try`). A step
+        is halved where it is refused — its corrector fails or leaves the branch, the tangent's
+        inertia changes, or λ turns back (the top is passed: a limit point where the inertia
+        changed by one, else where λ fell by more than :data:`WALK_LOSS`). The walk may go on
+        past ``state``'s probe value by one more step's change (the branch left can reach
+        beyond the state the step landed on: knock-down 35 mm at x = 50), not past the path's
+        target; a step past that limit goes half way to it. The branch ends where the halving
+        runs below :data:`WALK_MIN_FRACTION` of the first step on refusals; a walk that runs
+        out of its :data:`WALK_TRIES` correctors or reaches the limit still rising finds no
+        top, and so does one that passes ``state``'s probe value on ``state`` itself (within
+        :data:`WALK_LOSS`: the step did not leave the branch; the snap-back truss, whose arc
+        steps bend hard near its minimum). Where the branch ended or λ turned back, the
+        walk's highest (lowest) equilibrium —
+        ``last`` itself where none converged — is the step's located extremum (its fraction
+        of the step at most 1), a bound of the top from below (above), the top lying within
+        the last refused step of it in the probe, if one of these shows that load was lost
+        beyond it:
 
-        * ``state`` lies below it by more than :data:`WALK_LOSS` of its load (fig. 6 as
-          shipped, 1915.3 after 1975.8);
-        * λ turned back on the branch (a smooth top, passed by a walk step);
-        * the walk reached the branch's end with its slope dw/dλ still at least
-          :data:`WALK_SLOPE_KEPT` of the one at ``last`` (no turn of w ahead), and ``state``
-          lies below that end's tangent line, extrapolated to its probe value, by more than
-          :data:`WALK_LOSS` of the end's load (the knock-down study's 10-mm debond at
-          x = 110, whose rescue went straight to the target: the same top, 2060.0, as its
-          mirror image at x = 190, whose rescue landed below it).
+        * ``state`` lies below the branch by more than :data:`WALK_LOSS` of its load: below
+          the walk's top, or, where the walk passed ``state``'s probe value, below the branch
+          there (fig. 6 as shipped, 1915.3 after 1975.8);
+        * λ turned back on the branch (above);
+        * the walk ended short of ``state``'s probe value, its slope dw/dλ there still at
+          least :data:`WALK_SLOPE_KEPT` of the one at ``last`` (no turn of w ahead), and
+          ``state`` lies below the branch continued
+          to its probe value by more than :data:`WALK_LOSS` of the end's load — continued
+          quadratically in the probe with the curvature of the step before ``last``, where
+          concave (a concave branch that goes on lies below its tangent line:
+          tests/solver/test_solver_probe_rescue.py).
 
         Otherwise nothing is reported (fig. 7 c4: its arc collapsed on a branch that goes on
-        rising, its contact pairs opening and closing; the walk's steps all rose). The walk's
+        rising; the knock-down study's 10-mm debond at x = 110, whose rescue went on to the
+        target with no sign of the snap its mirror image at x = 190 shows). The walk's
         equilibria are not path states; the path's settings are left as they were.
         """
         name, rate = self.opt.until_probe, last.probe_rate
@@ -872,86 +893,124 @@ class _Follower:
         if not first > 0.0:
             return
         failed_once, sigma = self.failed_once, self.sigma
+        settings = dataclasses.replace(  # as the path's correctors are at the walk's start
+            self._newton_settings(self.divergence_rises, self.limit_corrections),
+            max_iterations=self.opt.desired_iterations)
         u, lam, tangent, v, rate_end = last.u, last.load_factor, t, v0, rate
+        far = v1 + (v1 - v0)  # the branch left may go on past ``state``'s probe value ...
+        if self.opt.until_value is not None and direction * (far - self.opt.until_value) > 0.0:
+            far = self.opt.until_value  # ... but not past the path's target
+        at_end = None  # λ of the branch left at ``state``'s probe value, once walked past it
         best = None
         delta, tries = first, 0
-        ended = turned = False  # the halving ran out at the branch's end; λ turned back on it
+        refused = False  # a try was refused since the walk's last equilibrium
+        turned = False  # λ turned back on the branch (beyond WALK_LOSS)
+        ended = False  # the halving ran out on refusals: the branch ends there
         while tries < WALK_TRIES:
             if delta < WALK_MIN_FRACTION * first:
-                ended = True
+                ended = refused
                 break
             goal = v + direction * delta
-            if direction * (v1 - goal) <= 0.0:  # not past the step's end: half the way to it
-                delta = 0.5 * abs(v1 - v)
+            if direction * (far - goal) <= 0.0:  # not past a step beyond: half the way to it
+                half = 0.5 * abs(far - v)
+                if not half < delta:
+                    break
+                delta = half
                 continue
             tries += 1
-            trial = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots)
-            back = trial is not None and sign * (trial.load_factor - lam) < 0.0
-            turned = turned or back
-            if trial is None or back:
+            trial, change = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots,
+                                           settings)
+            if trial is not None and sign * (trial.load_factor - lam) < 0.0:
+                # past a top of the branch: a limit point where the tangent's inertia changed
+                # by one, else where λ fell by more than WALK_LOSS (no noise)
+                turned = turned or abs(change) == 1 or \
+                    sign * (trial.load_factor - lam) < -WALK_LOSS * abs(lam)
+                trial = None  # nearer
+            elif change:
+                trial = None  # another inertia, λ still rising: off the branch
+            if trial is None:
+                refused = True
                 delta *= 0.5
                 continue
             try:
                 tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS:
                 break
+            if at_end is None and direction * (goal - v1) >= 0.0:  # (linear between the two)
+                at_end = lam + (trial.load_factor - lam) * (v1 - v) / (goal - v)
             u, lam, v, best, rate_end = trial.u, trial.load_factor, goal, trial, \
                 self._probe_rate(tangent)
+            refused = False
         self.failed_once, self.sigma = failed_once, sigma
-        if best is None and not ended:
-            return
+        if not (ended or turned):
+            return  # the branch goes on (or the walk ran out of tries): no top found on it
         # no step of the walk converged but the branch ended: it ends within its smallest
         # step of ``last`` itself (knock-down 40 mm at x = 70: 0.06 % below the fine path's top)
         top, top_u = (best.load_factor, best.u) if best is not None else (lam, last.u)
         lost = WALK_LOSS * abs(top)
-        dropped = sign * (top - state.load_factor) > lost
+        if at_end is not None and abs(at_end - state.load_factor) <= lost:
+            return  # ``state`` lies on the branch walked: the step did not leave it
+        # the branch left above ``state`` at its probe value (or its top, short of it)
+        dropped = sign * ((top if at_end is None else at_end) - state.load_factor) > lost
         abrupt = False
-        if ended and rate_end is not None and rate_end / rate >= WALK_SLOPE_KEPT:
-            # the step's end state below the end's tangent line by more than WALK_LOSS
-            on_line = top + (v1 - v) / rate_end
-            abrupt = sign * (on_line - state.load_factor) > lost
+        if ended and at_end is None and rate_end is not None and \
+                rate_end / rate >= WALK_SLOPE_KEPT:
+            # the step's end state below the branch continued to its probe value by more than
+            # WALK_LOSS: continued quadratically in w with the curvature of the step before
+            # (from ``before``'s and ``last``'s slopes), if concave (the walk's own slopes,
+            # a few thousandths of a mm apart at a snap, do not measure it)
+            rate_before = self.states[-3].probe_rate
+            bend = 0.0
+            if rate_before:
+                bend = (1.0 / rate - 1.0 / rate_before) / (v0 - before)
+                bend = bend if sign * bend < 0.0 else 0.0
+            on_branch = top + (v1 - v) / rate_end + 0.5 * bend * (v1 - v) ** 2
+            abrupt = sign * (on_branch - state.load_factor) > lost
         if not (dropped or turned or abrupt):
             return
         ends = (last.load_factor, state.load_factor)
         probes = self.probes(top_u)
-        state.extremum = Extremum("max" if sign > 0 else "min",
-                                  max(0.0, (probes[name] - v0) / (v1 - v0)), top, probes, ends)
+        fraction = min(1.0, max(0.0, (probes[name] - v0) / (v1 - v0)))  # (a top past it: 1)
+        state.extremum = Extremum("max" if sign > 0 else "min", fraction, top, probes, ends)
 
     def _walk_try(self, name: str, goal: float, u: np.ndarray, lam: float, t: np.ndarray,
-                  negative_pivots: int | None) -> _Trial | None:
-        """One corrector of :meth:`_walk_branch_left` to ``value(name) = goal`` (None: off it).
+                  negative_pivots: int | None,
+                  settings: NewtonSettings) -> tuple[_Trial | None, int]:
+        """One corrector of :meth:`_walk_branch_left` to ``value(name) = goal``.
 
-        The predictor is the load tangent ``t`` at ``(u, λ)``; the rising test stops a diverging
-        corrector early, and one that needs more than ``desired_iterations`` fails (the walk's
-        steps are short: on fig. 6 those that converge take 3-6 iterations, while those that do
-        not ran to the 25 allowed). Refused: a failed corrector, another inertia than
-        ``negative_pivots``, a corrector that moved more than ``max_correction_ratio`` × the
-        predictor from it (a jump to another branch), an inadmissible state.
+        Returns the equilibrium (None: off the branch) and the change of the tangent's
+        negative pivots from ``negative_pivots`` (0 where either is unknown).
+
+        The predictor is the load tangent ``t`` at ``(u, λ)``; ``settings`` are the path's
+        corrector settings at the walk's start (rising test, contact-limited corrections) with
+        at most ``desired_iterations`` iterations (the walk's steps are short: on fig. 6 those
+        that converge take 3-6 iterations, while those that do not ran to the 25 allowed).
+        Off the branch: a failed corrector, a corrector that moved more than
+        ``max_correction_ratio`` × the predictor from it (a jump to another branch), an
+        inadmissible state.
         """
         c = self.c[name]
         ct = self.dot(c, t)
         if ct == 0.0 or not math.isfinite(ct):
-            return None
+            return None, 0
         dlam = (goal - self.dot(c, u)) / ct
         try:
             res = self._correct(u + dlam * t, lam + dlam, ProbeConstraint(c, goal, self.dot),
-                                dataclasses.replace(self._newton_settings(DIVERGENCE_RISES),
-                                                    max_iterations=self.opt.desired_iterations),
-                                u, lam)
+                                settings, u, lam)
         except RECOVERABLE_ERRORS:
-            return None
+            return None, 0
         if not res.converged or res.factorization is None:
-            return None
-        neg = res.factorization.negative_pivots
-        if negative_pivots is not None and neg != negative_pivots:
-            return None
+            return None, 0
         reach = self.wnorm(dlam * t, dlam)
         if self.wnorm(res.u - u - dlam * t, res.load_factor - lam - dlam) > \
                 self.opt.max_correction_ratio * reach:
-            return None
+            return None, 0
         if self.admissible is not None and self.admissible(res.u):
-            return None
-        return _Trial(res.u, res.load_factor, res.iterations, res.factorization, res.rises)
+            return None, 0
+        trial = _Trial(res.u, res.load_factor, res.iterations, res.factorization, res.rises)
+        neg = res.factorization.negative_pivots
+        change = 0 if negative_pivots is None or neg is None else neg - negative_pivots
+        return trial, change
 
     def _inside_step(self, h: float, last: PathState, t: np.ndarray) -> _Trial | None:
         """A step of ``h`` from ``last`` whose equilibrium is not a path state (or None).
@@ -1133,10 +1192,8 @@ class _Follower:
             why = self.admissible(res.u)
             if why:
                 return None, f"{INADMISSIBLE}: {why}"
-        arc = opt.control == "arc-length"
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization,
-                      res.rises, res.increment_iterations, dlam if arc else None,
-                      dist / pred_len if arc and pred_len > 0.0 else None), "converged"
+                      res.rises, res.increment_iterations), "converged"
 
     def _newton_settings(self, rises: int = 0, limit: bool | None = None) -> NewtonSettings:
         """Corrector settings; the force floor is ‖f_ref‖ × the largest |λ| reached so far.
