@@ -114,12 +114,13 @@ SETTLING_BEND = math.radians(2.0)
 #: most this many times the increment the step-size controller asks for then
 #: (:meth:`_Follower._bent_half`).
 HALF_REACH = 1.25
-#: An arc step whose corrector takes back more than this fraction of its predictor's load
-#: change, with the tangent's inertia unchanged, may have jumped to another branch past a snap:
-#: the branch it left is walked as a rescued step's is (:meth:`_Follower._jumped`) ...
+#: A step of an arc-length path whose load change falls short of its tangent's by more than
+#: this fraction, with the tangent's inertia unchanged, may have jumped to another branch past
+#: a snap: the branch it left is walked as a rescued step's is (:meth:`_Follower._jumped`) ...
 JUMP_LOSS = 0.3
-#: ... or whose corrector moved further than this fraction of its predictor's length (the
-#: face's snapped shape appears in the correction, at little loss of load).
+#: ... or that leaves its tangent's line by more than this fraction of its projection on it
+#: (an arc step: its corrector's distance over its predictor's length; the face's snapped
+#: shape appears in the correction, at little loss of load).
 JUMP_CORRECTION = 0.25
 #: The walk along the branch a step jumped from (:meth:`_Follower._walk_branch_left`): its
 #: correctors at most, and its smallest probe step as a fraction of its first.
@@ -128,9 +129,9 @@ WALK_MIN_FRACTION = 1.0 / 16.0
 #: A walk that reaches the branch's end with its slope dw/dλ at least this fraction of the one
 #: it started with ended abruptly (no turn of w ahead, where dw/dλ would fall to 0) ...
 WALK_SLOPE_KEPT = 0.5
-#: ... and its end is a top where the step's end state lies below the end's tangent line,
-#: extrapolated to its probe value, by more than this fraction of the end's load (load lost);
-#: or below the walk's top itself by as much.
+#: ... and its end is a top where the step's end state lies below the branch continued to its
+#: probe value by more than this fraction of the end's load (load lost); or below the walk's
+#: top, or the branch walked past it, by as much.
 WALK_LOSS = 1e-3
 
 
