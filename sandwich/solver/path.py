@@ -867,6 +867,12 @@ class _Follower:
           the walk's top, or, where the walk passed ``state``'s probe value, below the branch
           there (fig. 6 as shipped, 1915.3 after 1975.8);
         * λ turned back on the branch (above);
+        * the branch ended, and one corrector from its end under the path's own settings
+          (any branch), as far in the probe as the step before ``last`` went (short of
+          ``state``), converges below the top by more than :data:`WALK_LOSS` of it (the
+          knock-down study's 10-mm debond at x = 110, whose rescue went on to the target:
+          2023.4 there, 2060.0 at the end — the top and the state after it its mirror image at
+          x = 190 shows);
         * the walk ended short of ``state``'s probe value, its slope dw/dλ there still at
           least :data:`WALK_SLOPE_KEPT` of the one at ``last`` (no turn of w ahead), and
           ``state`` lies below the branch continued
@@ -876,9 +882,8 @@ class _Follower:
           tests/solver/test_solver_probe_rescue.py).
 
         Otherwise nothing is reported (fig. 7 c4: its arc collapsed on a branch that goes on
-        rising; the knock-down study's 10-mm debond at x = 110, whose rescue went on to the
-        target with no sign of the snap its mirror image at x = 190 shows). The walk's
-        equilibria are not path states; the path's settings are left as they were.
+        rising). The walk's equilibria are not path states; the path's settings are left as
+        they were.
         """
         name, rate = self.opt.until_probe, last.probe_rate
         if state.extremum is not None or name is None or name != self.rate_probe \
@@ -967,6 +972,16 @@ class _Follower:
                 bend = bend if sign * bend < 0.0 else 0.0
             on_branch = top + (v1 - v) / rate_end + 0.5 * bend * (v1 - v) ** 2
             abrupt = sign * (on_branch - state.load_factor) > lost
+        if ended and not (dropped or turned or abrupt):
+            # one corrector past the end as the path's own (any branch), as far as the step
+            # before ``last`` went: an equilibrium there below the top shows the load lost
+            # (knock-down 10 mm at x = 110, whose rescue went on to the target: 2023.4 at
+            # 0.25 mm past the end, as its mirror's rescue found at x = 190)
+            goal = v + direction * abs(v0 - before)
+            if direction * (v1 - goal) > 0.0:
+                beyond = self._control_to(name, goal, u, lam, tangent)
+                dropped = beyond is not None and sign * (top - beyond.load_factor) > lost
+            self.failed_once, self.sigma = failed_once, sigma
         if not (dropped or turned or abrupt):
             return
         ends = (last.load_factor, state.load_factor)

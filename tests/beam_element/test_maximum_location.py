@@ -107,3 +107,21 @@ def test_a_face_snap_a_step_jumps_over_is_found_by_walking_the_branch(index, unt
     arm = min(case.values["centre"], 300.0 - case.values["centre"]) / 2.0
     euler = math.pi**2 * E * t**2 / (3.0 * span**2) * b * t * d / arm
     assert 0.85 * euler < first.load_factor < euler
+
+
+def test_mirror_image_debonds_report_the_same_snap():
+    # Symmetry: the knock-down study's 10-mm debonds at x = 110 and x = 190 are mirror images
+    # of each other (the span, the supports and the load are symmetric about x = 150). Their
+    # paths are not: at 190 the probe rescue lands below the snap (2023.1, after 2059.9); at
+    # 110 it goes on to the target (2137.5), and the snap is seen only by the walk from before
+    # it and its corrector past the branch's end. Before that corrector, x = 110 reported no
+    # limit point at all, its capacity 3.8 % above its mirror's.
+    study = load_study(ROOT / "studies" / "shipped" / "fig5-knockdown.toml")
+    tops = []
+    for centre in (110.0, 190.0):
+        case = next(c for c in study.cases
+                    if c.values == {"length": 10.0, "centre": centre})
+        first = solve_run(case.scene).solution.limit_points[0]
+        assert first.kind == "max"
+        tops.append(first.load_factor)
+    assert abs(tops[0] - tops[1]) <= 1e-4 * tops[1]
