@@ -899,95 +899,96 @@ class _Follower:
         if not first > 0.0:
             return
         failed_once, sigma = self.failed_once, self.sigma
-        settings = dataclasses.replace(  # as the path's correctors are at the walk's start
-            self._newton_settings(self.divergence_rises, self.limit_corrections),
-            max_iterations=self.opt.desired_iterations)
-        u, lam, tangent, v, rate_end = last.u, last.load_factor, t, v0, rate
-        far = v1 + (v1 - v0)  # the branch left may go on past ``state``'s probe value ...
-        if self.opt.until_value is not None and direction * (far - self.opt.until_value) > 0.0:
-            far = self.opt.until_value  # ... but not past the path's target
-        at_end = None  # λ of the branch left at ``state``'s probe value, once walked past it
-        best = None
-        delta, tries = first, 0
-        refused = False  # a try was refused since the walk's last equilibrium
-        turned = False  # λ turned back on the branch (beyond WALK_LOSS)
-        ended = False  # the halving ran out on refusals: the branch ends there
-        while tries < WALK_TRIES:
-            if delta < WALK_MIN_FRACTION * first:
-                ended = refused
-                break
-            goal = v + direction * delta
-            if direction * (far - goal) <= 0.0:  # not past a step beyond: half the way to it
-                half = 0.5 * abs(far - v)
-                if not half < delta:
+        try:
+            settings = dataclasses.replace(  # as the path's correctors are at the walk's start
+                self._newton_settings(self.divergence_rises, self.limit_corrections),
+                max_iterations=self.opt.desired_iterations)
+            u, lam, tangent, v, rate_end = last.u, last.load_factor, t, v0, rate
+            far = v1 + (v1 - v0)  # the branch left may go on past ``state``'s probe value ...
+            if self.opt.until_value is not None and direction * (far - self.opt.until_value) > 0.0:
+                far = self.opt.until_value  # ... but not past the path's target
+            at_end = None  # λ of the branch left at ``state``'s probe value, once walked past it
+            best = None
+            delta, tries = first, 0
+            refused = False  # a try was refused since the walk's last equilibrium
+            turned = False  # λ turned back on the branch (beyond WALK_LOSS)
+            ended = False  # the halving ran out on refusals: the branch ends there
+            while tries < WALK_TRIES:
+                if delta < WALK_MIN_FRACTION * first:
+                    ended = refused
                     break
-                delta = half
-                continue
-            tries += 1
-            trial, change = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots,
-                                           settings)
-            if trial is not None and sign * (trial.load_factor - lam) < 0.0:
-                # past a top of the branch: a limit point where the tangent's inertia changed
-                # by one, else where λ fell by more than WALK_LOSS (no noise)
-                turned = turned or abs(change) == 1 or \
-                    sign * (trial.load_factor - lam) < -WALK_LOSS * abs(lam)
-                trial = None  # nearer
-            elif change:
-                trial = None  # another inertia, λ still rising: off the branch
-            if trial is None:
-                refused = True
-                delta *= 0.5
-                continue
-            try:
-                tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
-            except RECOVERABLE_ERRORS:
-                break
-            if at_end is None and direction * (goal - v1) >= 0.0:  # (linear between the two)
-                at_end = lam + (trial.load_factor - lam) * (v1 - v) / (goal - v)
-            u, lam, v, best, rate_end = trial.u, trial.load_factor, goal, trial, \
-                self._probe_rate(tangent)
-            refused = False
-        self.failed_once, self.sigma = failed_once, sigma
-        if not (ended or turned):
-            return  # the branch goes on (or the walk ran out of tries): no top found on it
-        # no step of the walk converged but the branch ended: it ends within its smallest
-        # step of ``last`` itself (knock-down 40 mm at x = 70: 0.06 % below the fine path's top)
-        top, top_u = (best.load_factor, best.u) if best is not None else (lam, last.u)
-        lost = WALK_LOSS * abs(top)
-        if at_end is not None and abs(at_end - state.load_factor) <= lost:
-            return  # ``state`` lies on the branch walked: the step did not leave it
-        # the branch left above ``state`` at its probe value (or its top, short of it)
-        dropped = sign * ((top if at_end is None else at_end) - state.load_factor) > lost
-        abrupt = False
-        if ended and at_end is None and rate_end is not None and \
-                rate_end / rate >= WALK_SLOPE_KEPT:
-            # the step's end state below the branch continued to its probe value by more than
-            # WALK_LOSS: continued quadratically in w with the curvature of the step before
-            # (from ``before``'s and ``last``'s slopes), if concave (the walk's own slopes,
-            # a few thousandths of a mm apart at a snap, do not measure it)
-            rate_before = self.states[-3].probe_rate
-            bend = 0.0
-            if rate_before:
-                bend = (1.0 / rate - 1.0 / rate_before) / (v0 - before)
-                bend = bend if sign * bend < 0.0 else 0.0
-            on_branch = top + (v1 - v) / rate_end + 0.5 * bend * (v1 - v) ** 2
-            abrupt = sign * (on_branch - state.load_factor) > lost
-        if ended and not (dropped or turned or abrupt):
-            # one corrector past the end as the path's own (any branch), as far as the step
-            # before ``last`` went: an equilibrium there below the top shows the load lost
-            # (knock-down 10 mm at x = 110, whose rescue went on to the target: 2023.4 at
-            # 0.25 mm past the end, as its mirror's rescue found at x = 190)
-            goal = v + direction * abs(v0 - before)
-            if direction * (v1 - goal) > 0.0:
-                beyond = self._control_to(name, goal, u, lam, tangent)
-                dropped = beyond is not None and sign * (top - beyond.load_factor) > lost
+                goal = v + direction * delta
+                if direction * (far - goal) <= 0.0:  # not past a step beyond: half the way to it
+                    half = 0.5 * abs(far - v)
+                    if not half < delta:
+                        break
+                    delta = half
+                    continue
+                tries += 1
+                trial, change = self._walk_try(name, goal, u, lam, tangent, last.negative_pivots,
+                                               settings)
+                if trial is not None and sign * (trial.load_factor - lam) < 0.0:
+                    # past a top of the branch: a limit point where the tangent's inertia changed
+                    # by one, else where λ fell by more than WALK_LOSS (no noise)
+                    turned = turned or abs(change) == 1 or \
+                        sign * (trial.load_factor - lam) < -WALK_LOSS * abs(lam)
+                    trial = None  # nearer
+                elif change:
+                    trial = None  # another inertia, λ still rising: off the branch
+                if trial is None:
+                    refused = True
+                    delta *= 0.5
+                    continue
+                try:
+                    tangent = np.asarray(trial.factorization.solve(self.f_ref), dtype=float)
+                except RECOVERABLE_ERRORS:
+                    break
+                if at_end is None and direction * (goal - v1) >= 0.0:  # (linear between the two)
+                    at_end = lam + (trial.load_factor - lam) * (v1 - v) / (goal - v)
+                u, lam, v, best, rate_end = trial.u, trial.load_factor, goal, trial, \
+                    self._probe_rate(tangent)
+                refused = False
+            if not (ended or turned):
+                return  # the branch goes on (or the walk ran out of tries): no top found on it
+            # no step of the walk converged but the branch ended: it ends within its smallest
+            # step of ``last`` itself (knock-down 40 mm at x = 70: 0.06 % below the fine path's top)
+            top, top_u = (best.load_factor, best.u) if best is not None else (lam, last.u)
+            lost = WALK_LOSS * abs(top)
+            if at_end is not None and abs(at_end - state.load_factor) <= lost:
+                return  # ``state`` lies on the branch walked: the step did not leave it
+            # the branch left above ``state`` at its probe value (or its top, short of it)
+            dropped = sign * ((top if at_end is None else at_end) - state.load_factor) > lost
+            abrupt = False
+            if ended and at_end is None and rate_end is not None and \
+                    rate_end / rate >= WALK_SLOPE_KEPT:
+                # the step's end state below the branch continued to its probe value by more than
+                # WALK_LOSS: continued quadratically in w with the curvature of the step before
+                # (from ``before``'s and ``last``'s slopes), if concave (the walk's own slopes,
+                # a few thousandths of a mm apart at a snap, do not measure it)
+                rate_before = self.states[-3].probe_rate
+                bend = 0.0
+                if rate_before:
+                    bend = (1.0 / rate - 1.0 / rate_before) / (v0 - before)
+                    bend = bend if sign * bend < 0.0 else 0.0
+                on_branch = top + (v1 - v) / rate_end + 0.5 * bend * (v1 - v) ** 2
+                abrupt = sign * (on_branch - state.load_factor) > lost
+            if ended and not (dropped or turned or abrupt):
+                # one corrector past the end as the path's own (any branch), as far as the step
+                # before ``last`` went: an equilibrium there below the top shows the load lost
+                # (knock-down 10 mm at x = 110, whose rescue went on to the target: 2023.4 at
+                # 0.25 mm past the end, as its mirror's rescue found at x = 190)
+                goal = v + direction * abs(v0 - before)
+                if direction * (v1 - goal) > 0.0:
+                    beyond = self._control_to(name, goal, u, lam, tangent)
+                    dropped = beyond is not None and sign * (top - beyond.load_factor) > lost
+            if not (dropped or turned or abrupt):
+                return
+            ends = (last.load_factor, state.load_factor)
+            probes = self.probes(top_u)
+            fraction = min(1.0, max(0.0, (probes[name] - v0) / (v1 - v0)))  # (a top past it: 1)
+            state.extremum = Extremum("max" if sign > 0 else "min", fraction, top, probes, ends)
+        finally:  # the walk's correctors are not the path's
             self.failed_once, self.sigma = failed_once, sigma
-        if not (dropped or turned or abrupt):
-            return
-        ends = (last.load_factor, state.load_factor)
-        probes = self.probes(top_u)
-        fraction = min(1.0, max(0.0, (probes[name] - v0) / (v1 - v0)))  # (a top past it: 1)
-        state.extremum = Extremum("max" if sign > 0 else "min", fraction, top, probes, ends)
 
     def _walk_try(self, name: str, goal: float, u: np.ndarray, lam: float, t: np.ndarray,
                   negative_pivots: int | None,
@@ -997,7 +998,7 @@ class _Follower:
         Returns the equilibrium (None: off the branch) and the change of the tangent's
         negative pivots from ``negative_pivots`` (0 where either is unknown).
 
-        The predictor is the load tangent ``t`` at ``(u, λ)``; ``settings`` are the path's
+        :meth:`_control_to` from ``(u, λ)`` with the load tangent ``t``; ``settings`` are the path's
         corrector settings at the walk's start (rising test, contact-limited corrections) with
         at most ``desired_iterations`` iterations (the walk's steps are short: on fig. 6 those
         that converge take 3-6 iterations, while those that do not ran to the 25 allowed).
@@ -1005,26 +1006,21 @@ class _Follower:
         ``max_correction_ratio`` × the predictor from it (a jump to another branch), an
         inadmissible state.
         """
-        c = self.c[name]
-        ct = self.dot(c, t)
-        if ct == 0.0 or not math.isfinite(ct):
-            return None, 0
-        dlam = (goal - self.dot(c, u)) / ct
         try:
-            res = self._correct(u + dlam * t, lam + dlam, ProbeConstraint(c, goal, self.dot),
-                                settings, u, lam)
+            trial = self._control_to(name, goal, u, lam, t, settings)
         except RECOVERABLE_ERRORS:
+            trial = None
+        if trial is None:
             return None, 0
-        if not res.converged or res.factorization is None:
-            return None, 0
+        c = self.c[name]
+        dlam = (goal - self.dot(c, u)) / self.dot(c, t)  # the predictor's (_control_to's)
         reach = self.wnorm(dlam * t, dlam)
-        if self.wnorm(res.u - u - dlam * t, res.load_factor - lam - dlam) > \
+        if self.wnorm(trial.u - u - dlam * t, trial.load_factor - lam - dlam) > \
                 self.opt.max_correction_ratio * reach:
             return None, 0
-        if self.admissible is not None and self.admissible(res.u):
+        if self.admissible is not None and self.admissible(trial.u):
             return None, 0
-        trial = _Trial(res.u, res.load_factor, res.iterations, res.factorization, res.rises)
-        neg = res.factorization.negative_pivots
+        neg = trial.factorization.negative_pivots
         change = 0 if negative_pivots is None or neg is None else neg - negative_pivots
         return trial, change
 
@@ -1535,8 +1531,12 @@ class _Follower:
         return _Trial(u, lam, iters, trial.factorization)
 
     def _control_to(self, name: str, goal: float, u: np.ndarray, lam: float,
-                    t: np.ndarray) -> _Trial | None:
-        """One corrector from (u, λ) with ``value(name) = goal`` as control equation."""
+                    t: np.ndarray, settings: NewtonSettings | None = None) -> _Trial | None:
+        """One corrector from (u, λ) with ``value(name) = goal`` as control equation.
+
+        The predictor is the load tangent ``t`` scaled to the goal; ``settings`` default to
+        the path's (:meth:`_newton_settings`).
+        """
         if name == "λ":
             dlam, constraint = goal - lam, LoadConstraint(goal)
         else:
@@ -1546,8 +1546,8 @@ class _Follower:
                 return None
             dlam = (goal - self.dot(c, u)) / ct
             constraint = ProbeConstraint(c, goal, self.dot)
-        res = self._correct(u + dlam * t, lam + dlam, constraint, self._newton_settings(), u,
-                            lam)
+        res = self._correct(u + dlam * t, lam + dlam, constraint,
+                            settings or self._newton_settings(), u, lam)
         if not res.converged or res.factorization is None:
             return None
         return _Trial(res.u, res.load_factor, res.iterations, res.factorization)
