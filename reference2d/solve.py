@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 
+from reference2d.core_crushing import CoreCrushing, crushing_warning
 from reference2d.fracture import VcctEvaluator, history_columns
 from reference2d.model import Model2D, build_model
 from reference2d.profiles import ProfileSampler
@@ -73,11 +74,17 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     # of tests/fracture: G 0.07 of the closed form at 12x the load). No G then.
     tied_lips = a.kind == "linear" and bool(vcct.tips)
     states: list[tuple[int, float, np.ndarray]] = []
+    crushing = CoreCrushing(model)
+    core_states: list[tuple[int, float, object]] = []  # (step, λ, CoreState) of every state
 
     def record(state: PathState) -> None:
         contact = system.contact_summary()
+        core = crushing.at(state.u)
+        core_states.append((int(state.step), float(state.load_factor), core))
         extra = {"max_penetration": contact["max_penetration"],
                  "max_contact_pressure": contact["max_contact_pressure"],
+                 "core_min_stretch": core.min_stretch,
+                 "core_ellipticity": core.ellipticity,
                  "cuts": float(state.cuts)}
         if state.negative_pivots is not None:
             extra["negative_pivots"] = float(state.negative_pivots)
@@ -143,6 +150,13 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     onset = growth_onset(scene, rows)  # debonds with a toughness: first step G >= G_c
     if onset:
         extra["debond_growth"] = onset
+    if core_states:
+        extra["core_min_stretch"] = min(c.min_stretch for _, _, c in core_states)
+        extra["core_min_ellipticity"] = min(c.ellipticity for _, _, c in core_states)
+        crushed = [(s, lf, c) for s, lf, c in core_states if c.ellipticity <= 0.0]
+        extra["core_crushed_at_step"] = crushed[0][0] if crushed else None
+        if crushed:
+            message = f"{message}; {crushing_warning(crushed[0][2], crushed[0][0], crushed[0][1])}"
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)
