@@ -160,13 +160,19 @@ class CoreCrushing:
         return CoreState(stretch, q, x, z)
 
 
-def crushing_warning(worst: CoreState, step: int, load_factor: float) -> str:
-    """What a run is told when its core lost ellipticity at some state (else ``""``)."""
-    if worst.ellipticity > 0.0:
+def crushing_warning(first: CoreState, step: int, load_factor: float,
+                     before: tuple[int, float] | None = None) -> str:
+    """What a run is told from the first state whose core lost ellipticity (else ``""``).
+
+    ``before`` is the (step, λ) of the state before it: the loss lies in that step.
+    """
+    if first.ellipticity > 0.0:
         return ""
-    return (f"WARNING: the core crushed as a material at x = {worst.x:.4g}, z = {worst.z:.4g} mm "
-            f"(step {step}, λ = {load_factor:.6g}: the Green-strain law lost ellipticity there, "
-            f"smallest principal stretch in the core {worst.min_stretch:.3g}; uniaxially at "
-            f"1/√3 = {SVK_LIMIT_STRETCH:.3f}); a load maximum or a stop from there on is that "
-            "material limit of the St Venant-Kirchhoff core, not the structure's "
+    when = (f"in step {step} (λ {before[1]:.6g} → {load_factor:.6g})" if before is not None
+            else f"at step {step} (λ = {load_factor:.6g})")
+    return (f"WARNING: the core crushed as a material {when} at x = {first.x:.4g}, "
+            f"z = {first.z:.4g} mm (the Green-strain law lost ellipticity there, smallest "
+            f"principal stretch {first.min_stretch:.3g}); a load maximum "
+            "in or after that step may be this material limit of the St Venant-Kirchhoff core "
+            "rather than the structure's: compare with the beam, whose core does not localise "
             "(docs/reference2d.md)")

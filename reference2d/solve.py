@@ -153,10 +153,12 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     if core_states:
         extra["core_min_stretch"] = min(c.min_stretch for _, _, c in core_states)
         extra["core_min_ellipticity"] = min(c.ellipticity for _, _, c in core_states)
-        crushed = [(s, lf, c) for s, lf, c in core_states if c.ellipticity <= 0.0]
-        extra["core_crushed_at_step"] = crushed[0][0] if crushed else None
+        crushed = [k for k, (_, _, c) in enumerate(core_states) if c.ellipticity <= 0.0]
+        extra["core_crushed_at_step"] = core_states[crushed[0]][0] if crushed else None
         if crushed:
-            message = f"{message}; {crushing_warning(crushed[0][2], crushed[0][0], crushed[0][1])}"
+            step, lf, core = core_states[crushed[0]]
+            before = core_states[crushed[0] - 1][:2] if crushed[0] > 0 else None
+            message = f"{message}; {crushing_warning(core, step, lf, before)}"
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)

@@ -71,6 +71,7 @@ def check_errors(beam: dict[str, Any], ref: dict[str, Any]) -> dict[str, Any]:
         ok = isinstance(b, int | float) and isinstance(r, int | float) and r not in (0, 0.0)
         out[f"error_{q}"] = (float(b) - float(r)) / abs(float(r)) if ok else None
         out[f"2d_{q}"] = r if isinstance(r, int | float) else None
+    out["2d_core_crushed_load"] = ref.get("core_crushed_load")
     out["2d_status"] = ref.get("status", "")
     out["2d_reason"] = ref.get("reason", "")
     out["2d_seconds"] = ref.get("wall_seconds")

@@ -15,6 +15,9 @@ deflections are the scene's ``until`` probe (the first probe if it has none), in
 - ``contact_length``: length of x (mm) where either face presses on the core (contact pressure
   > 0) at the last profile, for the models that report it: the trapezoid of the contact flag
   over the profile's samples (within one sample spacing);
+- ``core_crushed_load``: λ at the first state whose core lost ellipticity (the 2D model's
+  crushing diagnostic, ``reference2d/core_crushing.py``; empty where the core did not crush, and
+  for the beam, whose core is a through-thickness polynomial and does not report it);
 - ``steps``, ``converged``, ``stop_reason``, ``solve_seconds``.
 """
 
@@ -36,6 +39,10 @@ def _probe(scene: Scene, sol: Solution) -> str | None:
     if a.until_probe is not None:
         return a.until_probe
     return scene.probes[0].name if scene.probes else None
+
+
+def _number(v: object) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
 
 
 def _finite(v: float | None) -> float | None:
@@ -103,5 +110,8 @@ def case_metrics(scene: Scene, sol: Solution) -> dict[str, object]:
     out["peak_tau_core"] = _signed_peak(sol, ("tau_core",), 0.0)
     out["peak_tau_core_5mm"] = _signed_peak(sol, ("tau_core",), PEAK_WINDOW)
     out["contact_length"] = contact_length(sol)
+    crushed = next((r.load_factor for r in hist if _number(q := r.extra.get("core_ellipticity"))
+                    and q <= 0), None)
+    out["core_crushed_load"] = _finite(crushed)
     out["solve_seconds"] = round(float(sol.wall_seconds), 3)
     return out

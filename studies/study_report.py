@@ -284,14 +284,16 @@ def summary(study: Study, table: list[dict[str, Any]], run_lines: list[str],
         md += ["## 2D spot checks", "",
                "Beam against the 2D model on the same scene, (beam − 2D) / |2D|:", "",
                "| case | " + " | ".join(a.name for a in study.axes) + " | indicator | "
-               f"2D status | {q} beam | {q} 2D | error {q} | error stiffness | 2D time (s) |",
-               "|" + "---|" * (len(study.axes) + 8)]
+               f"2D status | {q} beam | {q} 2D | error {q} | error stiffness | "
+               "2D core crushed at λ | 2D time (s) |",
+               "|" + "---|" * (len(study.axes) + 9)]
         for c in checks:
             md.append(f"| {c['case']} | " + " | ".join(
                 f"{c[a.name]:g}" if isinstance(c[a.name], float) else str(c[a.name])
                 for a in study.axes) + f" | {_pct(c.get('indicator'))} | {c.get('2d_status')} | "
                 f"{_g(c.get(q))} | {_g(c.get('2d_' + q))} | {_pct(c.get('error_' + q))} | "
-                f"{_pct(c.get('error_initial_stiffness'))} | {_g(c.get('2d_seconds'))} |")
+                f"{_pct(c.get('error_initial_stiffness'))} | {_g(c.get('2d_core_crushed_load'))} | "
+                f"{_g(c.get('2d_seconds'))} |")
         errs = [abs(e) for c in checks if (e := _num(c.get("error_" + q))) is not None]
         if errs:
             md += ["", f"Largest |error| of {q} over the checked cases: {100 * max(errs):.1f} %."]

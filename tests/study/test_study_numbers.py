@@ -60,6 +60,21 @@ def test_capacity_without_limit_point_is_the_load_at_the_target_and_none_if_stop
     assert m["load_at_until"] is None and m["capacity"] is None
 
 
+def test_core_crushed_load_is_the_first_state_whose_core_lost_ellipticity():
+    """The 2D model's history column ``core_ellipticity`` (≤ 0: crushed); the beam has none."""
+    scene = load_scene(ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
+    sol = _solution()
+    assert case_metrics(scene, sol)["core_crushed_load"] is None  # no column: the beam
+    for r, q in zip(sol.history, (1.0, 0.3, 0.3), strict=True):
+        r.extra["core_ellipticity"] = q
+    assert case_metrics(scene, sol)["core_crushed_load"] is None  # never crushed
+    sol.history[1].extra["core_ellipticity"] = 0.0  # at 0 the material has lost it
+    sol.history[2].extra["core_ellipticity"] = -0.2
+    assert case_metrics(scene, sol)["core_crushed_load"] == 50.0
+    e = check_errors({"capacity": 110.0}, {"capacity": 100.0, "core_crushed_load": 50.0})
+    assert e["2d_core_crushed_load"] == 50.0
+
+
 def test_contact_length_is_none_for_a_model_without_contact_columns():
     sol = _solution()
     del sol.profiles[0].columns["p_contact_top"], sol.profiles[0].columns["p_contact_bottom"]
