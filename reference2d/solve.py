@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from reference2d.core_crushing import CoreCrushing, crushing_warning
+from reference2d.core_crushing import CoreCrushing, CoreState, crushing_warning
 from reference2d.fracture import VcctEvaluator, history_columns
 from reference2d.model import Model2D, build_model
 from reference2d.profiles import ProfileSampler
@@ -75,7 +75,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     tied_lips = a.kind == "linear" and bool(vcct.tips)
     states: list[tuple[int, float, np.ndarray]] = []
     crushing = CoreCrushing(model)
-    core_states: list[tuple[int, float, object]] = []  # (step, λ, CoreState) of every state
+    core_states: list[tuple[int, float, CoreState]] = []  # (step, λ, the core) of every state
 
     def record(state: PathState) -> None:
         contact = system.contact_summary()
