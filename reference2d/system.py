@@ -165,6 +165,8 @@ class Reference2DSystem:
         self.A = self._create_matrix()
         self.b = fem_petsc.create_vector(self.R_form)
         self.last_contact: list[ct.ContactState] = []
+        self._active_flags: list[np.ndarray] = []  # of the last internal_force, per pair
+        self._slaves: list[int] = []
         self.counters = {"residuals": 0, "tangents": 0, "factorizations": 0,
                          "refactorizations": 0}
         self._mumps = MumpsSolver(self.comm)
@@ -194,6 +196,8 @@ class Reference2DSystem:
         with self.b.localForm() as b_local:
             b_local.set(0.0)
             states = self._contact_states(want_tangent=False)
+            self._active_flags = [state.active for state, _pair in states]
+            self._slaves = [len(state.gap) for state, _pair in states]
             if states:
                 f = np.zeros((self._nc, 2))
                 for state, _pair in states:
@@ -207,6 +211,17 @@ class Reference2DSystem:
         r[own_bc] = u[own_bc]
         self.counters["residuals"] += 1
         return r
+
+    def contact_set(self) -> np.ndarray:
+        """Active flags of every slave (all pairs) at the last :meth:`internal_force` (every rank).
+
+        The Newton corrector lets an iteration whose set is still changing go on past its
+        iteration limit (``sandwich/solver/newton.py``, "Contact-set settling").
+        """
+        flags = [np.zeros(n, dtype=bool) for n in self._slaves]
+        for f, active in zip(flags, self._active_flags, strict=True):
+            f[active] = True
+        return np.concatenate(flags) if flags else np.zeros(0, dtype=bool)
 
     def tangent(self, u: np.ndarray) -> PETSc.Mat:
         """K = ∂(f_int + f_contact)/∂u from ``ufl.derivative`` plus the contact Hessian."""
