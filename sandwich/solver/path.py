@@ -133,6 +133,11 @@ WALK_SLOPE_KEPT = 0.5
 #: probe value by more than this fraction of the end's load (load lost); or below the walk's
 #: top, or the branch walked past it, by as much.
 WALK_LOSS = 1e-3
+#: A converged state closer than this fraction of a passed step's length to that step's chord
+#: (in the norm ‖(u, ψλ)‖) lies on the path already followed: the path is retracing its branch
+#: (:meth:`_Follower._returned`). Chords of the last RETURN_SKIP steps are not compared.
+RETURN_FRACTION = 0.1
+RETURN_SKIP = 3
 
 
 @dataclass
@@ -405,6 +410,7 @@ class _Follower:
         self.c = {n: np.asarray(system.probe_vector(n), dtype=float) for n in names}
         self.f_ref = np.asarray(system.f_ref, dtype=float)
         self.states: list[PathState] = []
+        self._chord_lengths2: list[float] = []  # ‖(Δu, ψΔλ)‖² of each step, for _returned
         self.rescues: list[int] = []
         admissible = getattr(system, "admissible", None)
         self.admissible = admissible if callable(admissible) else None
@@ -521,6 +527,9 @@ class _Follower:
                 return self.finish(False, (
                     f"step {step}: the path came back through zero load (λ {last.load_factor:.6g}"
                     f" → {trial.load_factor:.6g}); stopped there (stop_at_load_reversal)"))
+            back = self._returned(state)
+            if back:
+                return self.finish(False, back)
             try:
                 t_next = np.asarray(fac.solve(self.f_ref), dtype=float)
             except RECOVERABLE_ERRORS as exc:  # pragma: no cover - factorization succeeded
@@ -799,6 +808,47 @@ class _Follower:
         probes = {n: v + s * (hi.probes[n] - v) for n, v in lo.probes.items()}
         x = (probes[name] - last.probes[name]) / (state.probes[name] - last.probes[name])
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
+
+    def _returned(self, state: PathState) -> str:
+        """Why ``state`` lies on the path already followed (``""`` if it does not).
+
+        A regular equilibrium curve does not come back to a point it passed; a path that does
+        has turned onto its own branch and follows it back (fig. 7 c2's 2D path after its
+        core crushed: a loop through crushed states, then the loading branch retraced through
+        λ = 0 to λ = −117, every step turning by a small angle, so the retrace guard on
+        consecutive steps never saw it). ``state`` is compared with the chord of every
+        earlier step but the last RETURN_SKIP, in ‖(u, ψλ)‖: within RETURN_FRACTION of that
+        step's length, the path stops there. A chord whose λ range lies farther from the
+        state's than that is skipped unmeasured (|ψ Δλ| bounds the distance from below).
+        """
+        k_last = len(self.states) - 2 - RETURN_SKIP  # the last chord compared ends at k_last + 1
+        psi = self.psi
+        chords = self._chord_lengths2
+        while len(chords) < len(self.states) - 1:
+            a, b = self.states[len(chords)], self.states[len(chords) + 1]
+            du = b.u - a.u
+            chords.append(self.dot(du, du) + (psi * (b.load_factor - a.load_factor)) ** 2)
+        x_l = psi * state.load_factor
+        for k in range(max(k_last + 1, 0)):
+            a, b = self.states[k], self.states[k + 1]
+            dl = psi * (b.load_factor - a.load_factor)
+            lo, hi = sorted((psi * a.load_factor, psi * b.load_factor))
+            length2 = chords[k]
+            gap_l = max(lo - x_l, x_l - hi, 0.0)
+            if length2 == 0.0 or gap_l * gap_l > RETURN_FRACTION**2 * length2:
+                continue
+            du = b.u - a.u
+            xu, xl = state.u - a.u, x_l - psi * a.load_factor
+            s = min(max((self.dot(xu, du) + xl * dl) / length2, 0.0), 1.0)
+            ru, rl = xu - s * du, xl - s * dl
+            d2 = self.dot(ru, ru) + rl * rl
+            if d2 <= RETURN_FRACTION**2 * length2:
+                return (f"step {state.step}: the path returned onto the states it passed in step "
+                        f"{k + 1} (λ {a.load_factor:.6g} → {b.load_factor:.6g}; within "
+                        f"{math.sqrt(d2 / length2):.2g} of that step's length): it is retracing "
+                        f"its own branch, turned by steps of small angle after a fold; stopped "
+                        f"there, the states kept")
+        return ""
 
     def _jumped(self, last: PathState, state: PathState, t: np.ndarray) -> bool:
         """Whether the step ``last`` → ``state`` may have landed on another branch past a snap.
