@@ -26,9 +26,10 @@ FIG4_CRUSH = pytest.mark.xfail(strict=True, reason=(
 # fig4, at a corner where a face end is held and the core bears on it
 CORNER_CRUSH = {
     "paper-fig7-cantilever-c2": pytest.mark.xfail(strict=True, reason=(
-        "core corner on the clamped bottom face (x=0, z=-12.5) crushes past the SVK limit "
-        "(stretch 0.33 -> 0 while lambda falls 659 -> 631) and inverts at w_top_tip=-32.1 mm; "
-        "-40 mm is out of reach")),
+        "core corner on the clamped bottom face (x=0.875, z=-12.33) crushes in step 11 "
+        "(lambda 669.5, the maximum); the path loops through crushed states and returns onto "
+        "its own branch at step 20 (w_top_tip -33.7 mm), where it stops; -40 mm is out of "
+        "reach (test_c2_full_path_stops_where_it_returns_onto_its_branch)")),
 }
 UNTIL = re.compile(r"(until\s*=\s*\{[^}]*value\s*=\s*)([-+0-9.eE]+)")
 FRACTION = 0.2
@@ -110,6 +111,24 @@ def test_fig6_full_path_passes_the_face_snap_maximum_without_crushing_the_core()
     beam_max = [lp.load_factor for lp in beam.limit_points if lp.kind == "max"]
     print(f"2D max {maxima[0]:.6g}, beam max {beam_max[:1]}, core crushed at step {crushed}")
     assert beam_max and maxima[0] == pytest.approx(beam_max[0], rel=1e-2)
+
+
+@pytest.mark.heavy
+def test_c2_full_path_stops_where_it_returns_onto_its_branch():
+    """fig. 7 c2: past its crush the 2D path loops and came back onto its own loading branch,
+    then ran it backwards through λ = 0 to λ = −117 (175 steps) until an element inverted. The
+    path follower now stops where a state returns onto a passed step (docs/solver.md): no state
+    after the turn with λ < 0 or with the tip deflection undone, and the crush reported."""
+    scene = load_scene(SCENES / "paper-fig7-cantilever-c2.toml")
+    sol = solve(scene, level="coarse")
+    assert not sol.converged and "returned onto the states it passed" in sol.message
+    lam = np.array([r.load_factor for r in sol.history])
+    w = np.array([r.probes[scene.analysis.until_probe] for r in sol.history])
+    assert lam.min() >= 0.0 and len(sol.history) < 40
+    top = int(np.argmax(lam))
+    assert np.all(w[top:] <= 0.95 * w[top])  # beyond its maximum the tip has not gone back
+    assert sol.extra["core_crushed_at_step"] is not None
+    assert sol.extra["core_crushed_at_step"] <= sol.history[top].step + 1
 
 
 def test_solution_carries_a_paraview_frame_of_the_last_step(tmp_path):
