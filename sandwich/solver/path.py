@@ -134,10 +134,11 @@ WALK_SLOPE_KEPT = 0.5
 #: top, or the branch walked past it, by as much.
 WALK_LOSS = 1e-3
 #: A converged state closer than this fraction of a passed step's length to that step's chord
-#: (in the norm ‖(u, ψλ)‖) lies on the path already followed: the path is retracing its branch
-#: (:meth:`_Follower._returned`). Chords of the last RETURN_SKIP steps are not compared.
+#: (in the norm ‖(u, ψλ)‖; a step the path has since travelled away from by its length) lies on
+#: the path already followed; RETURN_STATES such states in a row: the path is retracing its
+#: branch (:meth:`_Follower._returned`).
 RETURN_FRACTION = 0.1
-RETURN_SKIP = 3
+RETURN_STATES = 3
 
 
 @dataclass
@@ -411,6 +412,8 @@ class _Follower:
         self.f_ref = np.asarray(system.f_ref, dtype=float)
         self.states: list[PathState] = []
         self._chord_lengths2: list[float] = []  # ‖(Δu, ψΔλ)‖² of each step, for _returned
+        self._path_length: list[float] = [0.0]  # the path's length up to each state
+        self._returns: list[tuple[int, float]] = []  # the last states on the path followed
         self.rescues: list[int] = []
         admissible = getattr(system, "admissible", None)
         self.admissible = admissible if callable(admissible) else None
@@ -810,45 +813,60 @@ class _Follower:
         state.extremum = Extremum(kind, x, lam, probes, (lo.load_factor, hi.load_factor))
 
     def _returned(self, state: PathState) -> str:
-        """Why ``state`` lies on the path already followed (``""`` if it does not).
+        """Why the path ending at ``state`` is retracing its own branch (``""`` if it is not).
 
         A regular equilibrium curve does not come back to a point it passed; a path that does
         has turned onto its own branch and follows it back (fig. 7 c2's 2D path after its
         core crushed: a loop through crushed states, then the loading branch retraced through
         λ = 0 to λ = −117, every step turning by a small angle, so the retrace guard on
-        consecutive steps never saw it). ``state`` is compared with the chord of every
-        earlier step but the last RETURN_SKIP, in ‖(u, ψλ)‖: within RETURN_FRACTION of that
-        step's length, the path stops there. A chord whose λ range lies farther from the
-        state's than that is skipped unmeasured (|ψ Δλ| bounds the distance from below).
+        consecutive steps never saw it). ``state`` lies on the path already followed when it
+        is within RETURN_FRACTION of an earlier step's length from that step's chord, in
+        ‖(u, ψλ)‖, counting only steps the path has since travelled away from by at least
+        their length (a run of short steps right after a long one stays near its chord
+        without returning). A single such state can be a near pass of another part of the
+        path (fig. 4's crushed 2D core: one state within 0.09, the next ones 0.1-0.4 away);
+        RETURN_STATES of them in a row are a retrace: the path stops. A step whose λ range
+        lies farther from the state than the fraction is skipped without a dot product
+        (|ψ Δλ| bounds the distance from below).
         """
-        k_last = len(self.states) - 2 - RETURN_SKIP  # the last chord compared ends at k_last + 1
         psi = self.psi
-        chords = self._chord_lengths2
+        chords, travelled = self._chord_lengths2, self._path_length
         while len(chords) < len(self.states) - 1:
             a, b = self.states[len(chords)], self.states[len(chords) + 1]
             du = b.u - a.u
             chords.append(self.dot(du, du) + (psi * (b.load_factor - a.load_factor)) ** 2)
+            travelled.append(travelled[-1] + math.sqrt(chords[-1]))
+        n = len(self.states) - 1  # the state's index; its own step is chord n − 1
         x_l = psi * state.load_factor
-        for k in range(max(k_last + 1, 0)):
-            a, b = self.states[k], self.states[k + 1]
-            dl = psi * (b.load_factor - a.load_factor)
-            lo, hi = sorted((psi * a.load_factor, psi * b.load_factor))
+        on = None
+        for k in range(max(n - 1, 0)):
             length2 = chords[k]
+            if length2 == 0.0 or (travelled[n] - travelled[k + 1]) ** 2 < length2:
+                continue  # not travelled away from it by its length yet
+            a, b = self.states[k], self.states[k + 1]
+            lo, hi = sorted((psi * a.load_factor, psi * b.load_factor))
             gap_l = max(lo - x_l, x_l - hi, 0.0)
-            if length2 == 0.0 or gap_l * gap_l > RETURN_FRACTION**2 * length2:
+            if gap_l * gap_l > RETURN_FRACTION**2 * length2:
                 continue
+            dl = psi * (b.load_factor - a.load_factor)
             du = b.u - a.u
             xu, xl = state.u - a.u, x_l - psi * a.load_factor
             s = min(max((self.dot(xu, du) + xl * dl) / length2, 0.0), 1.0)
             ru, rl = xu - s * du, xl - s * dl
             d2 = self.dot(ru, ru) + rl * rl
             if d2 <= RETURN_FRACTION**2 * length2:
-                return (f"step {state.step}: the path returned onto the states it passed in step "
-                        f"{k + 1} (λ {a.load_factor:.6g} → {b.load_factor:.6g}; within "
-                        f"{math.sqrt(d2 / length2):.2g} of that step's length): it is retracing "
-                        f"its own branch, turned by steps of small angle after a fold; stopped "
-                        f"there, the states kept")
-        return ""
+                on = (k, math.sqrt(d2 / length2))
+                break
+        self._returns = [*self._returns, on][-RETURN_STATES:] if on else []
+        if len(self._returns) < RETURN_STATES:
+            return ""
+        first = n - RETURN_STATES + 1
+        (k0, r0), (k, _) = self._returns[0], self._returns[-1]
+        return (f"step {state.step}: the path is retracing its own branch — steps {first}-{n} "
+                f"lie on the path it followed before (step {first} within {r0:.2g} of step "
+                f"{k0 + 1}'s length from it, λ {self.states[k0].load_factor:.6g} → "
+                f"{self.states[k0 + 1].load_factor:.6g}; step {n} on step {k + 1}), turned by "
+                f"steps of small angle after a fold; stopped there, the states kept")
 
     def _jumped(self, last: PathState, state: PathState, t: np.ndarray) -> bool:
         """Whether the step ``last`` → ``state`` may have landed on another branch past a snap.

@@ -90,3 +90,24 @@ def test_a_settled_set_keeps_the_ordinary_limit_and_the_extension_is_bounded():
     # it stopped because the set settled (SETTLED_ITERATIONS without a change), not the budget
     assert r.iterations < 5 + SETTLING_PER_PAIR * short.size
     assert SETTLED_ITERATIONS >= 1
+
+
+class ChatteringSet(StringWithSet):
+    """The same string, but its reported set flips between two (a chattering pair)."""
+
+    def __init__(self):
+        super().__init__()
+        self.calls = 0
+
+    def contact_set(self):
+        self.calls += 1
+        flags = np.zeros(self.size, dtype=bool)
+        flags[self.calls % 2] = True
+        return flags
+
+
+def test_a_set_that_only_cycles_is_chattering_and_keeps_the_ordinary_limit():
+    """Sets met before do not extend the corrector (fig. 9 d10's failing attempts: counting every
+    change made its 2D run 12 × slower on the same path)."""
+    r = _solve(ChatteringSet(), max_iterations=25, tol=1e-300)
+    assert not r.converged and r.iterations == 25

@@ -1,9 +1,9 @@
-"""The path follower stops where its path returns onto states it passed (``_Follower._returned``).
+"""The path follower stops where its path retraces its own branch (``_Follower._returned``).
 
-A regular equilibrium curve does not come back to a point it passed, so a state on an earlier
-step's chord means the path is retracing its own branch (docs/solver.md, "A path that returns
-onto itself"). Geometry checked on synthetic states (reference: the distance from a point to a
-segment, worked by hand below), in the norm ‖(u, ψλ)‖.
+A regular equilibrium curve does not come back to a point it passed: RETURN_STATES states in a
+row on the chords of steps the path had travelled away from mean it is retracing its branch
+(docs/solver.md, "A path that returns onto itself"). Geometry checked on synthetic paths
+(reference: point-to-segment distances worked by hand below), in the norm ‖(u, ψλ)‖, ψ = 1.
 """
 
 import math
@@ -12,56 +12,76 @@ import numpy as np
 from solver_toys import VonMisesTruss
 
 from sandwich.solver import PathOptions
-from sandwich.solver.path import RETURN_FRACTION, RETURN_SKIP, PathState, _Follower
+from sandwich.solver.path import RETURN_FRACTION, RETURN_STATES, PathState, _Follower
 
 
-def _follower_on(points: list[tuple[float, float]]) -> _Follower:
-    """A follower whose path is the (u, λ) points given (1 DOF, ψ = 1)."""
-    truss = VonMisesTruss(h=0.2)
-    f = _Follower(truss, PathOptions(control="arc-length", until_probe="w", until_value=1.0),
-                  ["w"], None)
+def _follower(points, dofs=1):
+    """A follower whose path so far is ``points``: (u, λ), u a float or a tuple of dofs."""
+    truss = VonMisesTruss(h=0.2) if dofs == 1 else VonMisesTruss(h=0.2, spring=1.0)
+    probe = "w" if dofs == 1 else "w1"
+    f = _Follower(truss, PathOptions(control="arc-length", until_probe=probe, until_value=1.0),
+                  [probe], None)
     f.psi = 1.0
-    f.states = [PathState(k, np.array([u]), lam, 1, {"w": u}, 0)
-                for k, (u, lam) in enumerate(points)]
+    for u, lam in points:
+        f.states.append(PathState(len(f.states), np.atleast_1d(np.array(u, dtype=float)), lam,
+                                  1, {}, 0))
     return f
 
 
-def _state(step: int, u: float, lam: float) -> PathState:
-    return PathState(step, np.array([u]), lam, 1, {"w": u}, 0)
+def _walk(f, points):
+    """Append each (u, λ) as the next state and ask the guard; the reasons, one per state."""
+    out = []
+    for u, lam in points:
+        state = PathState(len(f.states), np.atleast_1d(np.array(u, dtype=float)), lam, 1, {}, 0)
+        f.states.append(state)
+        out.append(f._returned(state))
+    return out
 
 
-def test_a_state_on_a_passed_chord_stops_the_path_and_one_beside_it_does_not():
-    out = [(float(s), float(s)) for s in range(11)]  # u = λ = 0 … 10: chords of length √2
-    f = _follower_on(out)
-    back = _state(11, 5.5, 5.5)  # on chord 6 (5 → 6): the branch retraced
-    why = f._returned(back)
-    assert "returned onto the states it passed in step 6" in why, why
-    # 0.5 above the line u = λ: distance 0.5/√2 = 0.25 of the chord's length √2 > 0.1
-    assert f._returned(_state(11, 5.5, 6.0)) == ""
-    # just inside the fraction: distance 0.09 × √2 from the chord, off its middle
-    d = 0.09 * math.sqrt(2.0)
+OUT = [(float(s), float(s)) for s in range(11)]  # u = λ = 0 … 10: chords of length √2
+
+
+def test_three_states_in_a_row_on_the_path_followed_stop_it():
+    f = _follower(OUT)
+    back = [(9.5, 9.5), (8.5, 8.5), (7.5, 7.5), (6.5, 6.5)]
+    reasons = _walk(f, back)
+    # the first one back lies on the last step, which it has not travelled away from by its
+    # length (0.71 of √2): not counted; the next three lie on step 9, 8, 7's chords
+    assert RETURN_STATES == 3 and reasons[:3] == ["", "", ""]
+    assert "is retracing its own branch" in reasons[3] and "steps 12-14" in reasons[3]
+
+
+def test_a_single_near_pass_does_not_stop_the_path():
+    """One state on an old chord, the next ones 0.25 of a chord's length beside it."""
+    f = _follower(OUT)
+    beside = 0.5  # λ above u by 0.5: distance 0.5/√2 = 0.25 × √2
+    reasons = _walk(f, [(9.5, 9.5), (8.5, 8.5 + beside), (7.5, 7.5 + beside), (6.5, 6.5)])
+    assert reasons == ["", "", "", ""]
+
+
+def test_the_fraction_of_the_chord_decides():
+    """Within 0.09 of the chord's length: on it; 0.11: beside it."""
     n = np.array([1.0, -1.0]) / math.sqrt(2.0)  # unit normal of the line u = λ
-    u, lam = np.array([5.5, 5.5]) + d * n
-    assert RETURN_FRACTION > 0.09 and f._returned(_state(11, u, lam)) != ""
+    for offset, stops in ((0.09, True), (0.11, False)):
+        f = _follower(OUT)
+        pts = [tuple(np.array([x, x]) + offset * math.sqrt(2.0) * n)
+               for x in (9.5, 8.5, 7.5, 6.5)]
+        reasons = _walk(f, pts)
+        assert (reasons[-1] != "") is stops, (offset, reasons)
+    assert 0.09 < RETURN_FRACTION < 0.11
 
 
-def test_the_last_chords_are_not_compared():
-    """A state on one of the last RETURN_SKIP chords is the path's own neighbourhood."""
-    out = [(float(s), float(s)) for s in range(11)]
-    f = _follower_on(out)
-    u = 10.0 - RETURN_SKIP + 0.5  # on the chord ending RETURN_SKIP - 1 states before the last
-    assert f._returned(_state(11, u, u)) == ""
-    u = 10.0 - RETURN_SKIP - 0.5  # on the chord before them: compared
-    assert f._returned(_state(11, u, u)) != ""
+def test_short_steps_after_a_long_one_are_not_a_return():
+    """After a long step, a stall in tiny steps lies on that step's chord without having left
+    it: those steps are not compared until the path has travelled their length away."""
+    f = _follower([(0.0, 0.0), (10.0, 10.0)])  # one long step
+    reasons = _walk(f, [(10.0 + 1e-3 * i, 10.0 - 2e-3 * i) for i in range(1, 8)])
+    assert reasons == [""] * 7
 
 
-def test_a_path_that_passes_near_in_load_but_far_in_displacement_goes_on():
-    """The same λ and probe as an earlier state but another shape (a snapped branch): 2 DOFs,
-    the second (the shape) far from the first branch's; never a return."""
-    truss = VonMisesTruss(h=0.2, spring=1.0)
-    f = _Follower(truss, PathOptions(control="arc-length", until_probe="w1", until_value=1.0),
-                  ["w1", "w2"], None)
-    f.psi = 1.0
-    f.states = [PathState(k, np.array([0.1 * k, 0.0]), 0.1 * k, 1, {}, 0) for k in range(11)]
-    assert f._returned(PathState(11, np.array([0.55, 2.0]), 0.55, 1, {}, 0)) == ""
-    assert f._returned(PathState(11, np.array([0.55, 0.0]), 0.55, 1, {}, 0)) != ""
+def test_the_same_load_and_probe_with_another_shape_is_not_a_return():
+    """2 DOFs: a snapped branch at the λ and w1 of earlier states, its second DOF elsewhere."""
+    f = _follower([((0.1 * k, 0.0), 0.1 * k) for k in range(11)], dofs=2)
+    assert _walk(f, [((0.55 - 0.1 * i, 2.0), 0.55 - 0.1 * i) for i in range(4)]) == [""] * 4
+    f = _follower([((0.1 * k, 0.0), 0.1 * k) for k in range(11)], dofs=2)
+    assert _walk(f, [((0.95 - 0.1 * i, 0.0), 0.95 - 0.1 * i) for i in range(4)])[-1] != ""
