@@ -113,8 +113,8 @@ MIN_CORRECTION_FRACTION = 1e-3
 LIMITED_CORRECTIONS = 3
 
 #: Contact-set settling (module docstring): more iterations per contact pair past
-#: ``max_iterations`` while the set changes, and the iterations after its last change that
-#: still count as settling.
+#: ``max_iterations`` while the set moves on to sets not met before, and the iterations after
+#: its last such move that still count as settling.
 SETTLING_PER_PAIR = 2
 SETTLED_ITERATIONS = 3
 
