@@ -143,6 +143,23 @@ def summarize(run: ModelRun) -> ModelSummary:
                         s.dofs, detected, reported)
 
 
+def crushed_note(model: str, sol: Solution) -> str:
+    """A note where ``sol``'s history says its core crushed (``core_ellipticity`` ≤ 0), else "".
+
+    The 2D model writes the column (``reference2d/core_crushing.py``); a model without it
+    gets no note.
+    """
+    for r in sol.history:
+        q = r.extra.get("core_ellipticity")
+        if isinstance(q, int | float) and not isinstance(q, bool) and q <= 0:
+            return (f"{model}: its core crushed as a material at step {r.step} "
+                    f"(λ {r.load_factor:.6g}; the St Venant-Kirchhoff core lost ellipticity): a "
+                    "limit load at or after it is that material limit, not the structure's, and "
+                    "a model whose core does not localise (the beam) goes on "
+                    "(docs/reference2d.md, \"Where the core crushes\")")
+    return ""
+
+
 def _ratio(num: float | None, den: float | None) -> float | None:
     if num is None or den is None or den == 0 or not math.isfinite(num / den):
         return None
@@ -169,6 +186,7 @@ def compute_metrics(scene_name: str, runs: dict[str, ModelRun], abscissa: str) -
         metrics.notes.extend(n for n in (note_ref, note_beam) if n and n not in metrics.notes)
         metrics.curves.append(curve_error(c_ref, c_beam, q, f"|{abscissa}|"))
     _profile_metrics(metrics, beam, ref, abscissa)
+    metrics.notes.extend(n for n in (crushed_note(REFERENCE, ref), crushed_note(BEAM, beam)) if n)
     metrics.releases = release_agreements(beam, ref, abscissa)
     lb, lr = metrics.models[BEAM].limit_loads, metrics.models[REFERENCE].limit_loads
     if lb and lr:

@@ -203,3 +203,27 @@ def test_a_frame_without_stress_is_refused_in_words():
     frame.cell_data.pop("von_mises")
     with pytest.raises(ValueError, match="no von_mises"):
         picture_of("2d", frame)
+
+
+def test_a_crushed_2d_core_is_noted_and_survives_reuse(tmp_path, scene, synth):
+    """The 2D history's core_ellipticity ≤ 0 from step 40 on: the comparison says where the
+    2D core crushed (reference: the synthetic column), also from reused result files; without
+    the column, no note."""
+    solvers = synth.fake_solvers(EPS)
+    solve_2d = solvers["2d"]
+
+    def crushing_2d(sc, progress=None):
+        sol = solve_2d(sc, progress)
+        for r in sol.history:
+            r.extra["core_ellipticity"] = 1.0 - r.step / 40.0
+        return sol
+
+    plain = compare(scene, tmp_path / "a", results_root=tmp_path / "r0", solvers=solvers)
+    assert not any("crushed" in n for n in plain.metrics.notes)
+    solvers["2d"] = crushing_2d
+    for out in ("b", "c"):  # solved, then reused from the written files
+        cmp = compare(scene, tmp_path / out, results_root=tmp_path / "r1", solvers=solvers)
+        notes = [n for n in cmp.metrics.notes if "crushed" in n]
+        assert len(notes) == 1 and notes[0].startswith("2d: its core crushed as a material at "
+                                                      "step 40 "), notes
+    assert cmp.runs["2d"].origin == "reused"
