@@ -9,12 +9,13 @@ ellipticity of the first elasticity tensor A = ∂P/∂F,
     A_iJkL = δ_ik S_JL + F_iM C_MJNL F_kN,      q(F) = min over unit a, N of a_i N_J A_iJkL a_k N_L,
 
 (q > 0: the material is stable against every localised mode a ⊗ N). In uniaxial compression
-along z, q vanishes for a = N = e_z where S_zz + λ² C_zzzz = 0, i.e. at λ² = (E_z/2)/(E_z/2 +
-Q_z) with E_z = Q_z − Q²/Q_x the uniaxial modulus: λ = 0.565 for an isotropic core with
-ν = 0.25, a little below 1/√3 (a localised mode cannot relax sideways). A 2D path whose load
-turns where some core point has q ≤ 0 has met this material limit, not a buckling of the
-structure (fig. 4 under the patch, fig. 6 at the pin's corner, the knock-down study's 75-mm
-debonds at their inner tip; docs/reference2d.md).
+of the isotropic core (ν = 0.25) q vanishes at λ = 0.601, in an oblique mode (N ≈ 64° from the
+axis), before dP/dλ = 0 at 1/√3: a localised mode cannot relax sideways (the axial mode
+a = N = e_z, S_zz + λ² Q_z = 0, would come only at λ = 0.565; tests/reference2d). A 2D path whose
+load turns where some core point has q ≤ 0 has met this material limit, not a buckling of the
+structure (fig. 4 under the patch, the knock-down study's 75-80-mm debonds at their inner tip,
+fig. 7 c2 at the clamp; not fig. 6, whose maximum is the debonded face's snap;
+docs/reference2d.md).
 The beam's core, a through-thickness polynomial, smooths such a local compression out.
 
 :class:`CoreCrushing` evaluates F at the 3×3 Gauss points of every core cell (material points;
@@ -38,7 +39,7 @@ GAUSS_DEGREE = 5  # the 3×3 Gauss points of each cell: the material points samp
 
 @dataclass(frozen=True)
 class CoreState:
-    """The core's worst material point at one state (cell centres, mm)."""
+    """The core's worst material point at one state (its Gauss points; x, z in mm)."""
 
     min_stretch: float  # smallest principal stretch √(eig C)
     ellipticity: float  # smallest q(F) / q(I): 1 at rest, ≤ 0 where the material is unstable
