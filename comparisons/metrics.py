@@ -25,7 +25,15 @@ import math
 from dataclasses import asdict, dataclass, field, is_dataclass
 
 from comparisons.pair import BEAM, REFERENCE
-from comparisons.paths import LOAD, CurveError, curve_error, limit_loads, path_curve, series
+from comparisons.paths import (
+    LOAD,
+    CurveError,
+    crushed_state,
+    curve_error,
+    limit_loads,
+    path_curve,
+    series,
+)
 from comparisons.profiles import (
     DEFLECTIONS,
     STRESSES,
@@ -144,20 +152,15 @@ def summarize(run: ModelRun) -> ModelSummary:
 
 
 def crushed_note(model: str, sol: Solution) -> str:
-    """A note where ``sol``'s history says its core crushed (``core_ellipticity`` ≤ 0), else "".
-
-    The 2D model writes the column (``reference2d/core_crushing.py``); a model without it
-    gets no note.
-    """
-    for r in sol.history:
-        q = r.extra.get("core_ellipticity")
-        if isinstance(q, int | float) and not isinstance(q, bool) and q <= 0:
-            return (f"{model}: its core crushed as a material at step {r.step} "
-                    f"(λ {r.load_factor:.6g}; the St Venant-Kirchhoff core lost ellipticity): a "
-                    "limit load at or after it is that material limit, not the structure's, and "
-                    "a model whose core does not localise (the beam) goes on "
-                    "(docs/reference2d.md, \"Where the core crushes\")")
-    return ""
+    """A note where ``sol``'s core crushed as a material (:func:`crushed_state`), else ""."""
+    r = crushed_state(sol)
+    if r is None:
+        return ""
+    return (f"{model}: its core crushed as a material at step {r.step} "
+            f"(λ {r.load_factor:.6g}; the St Venant-Kirchhoff core lost ellipticity): a "
+            "limit load at or after it is that material limit, not the structure's, and "
+            "a model whose core does not localise (the beam) goes on "
+            "(docs/reference2d.md, \"Where the core crushes\")")
 
 
 def _ratio(num: float | None, den: float | None) -> float | None:

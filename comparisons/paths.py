@@ -12,10 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sandwich.results import Solution
+from sandwich.results import Solution, StepRecord
 
 LOAD = "load_factor"
 LIMIT_DROP_RTOL = 0.005  # a load maximum counts when the load then falls by ≥ 0.5 % of it
+CORE_ELLIPTICITY = "core_ellipticity"  # history column of the 2D core's crushing diagnostic
 
 
 @dataclass(frozen=True)
@@ -50,6 +51,18 @@ def series(solution: Solution, name: str) -> np.ndarray:
     if name == LOAD:
         return np.array([r.load_factor for r in solution.history], dtype=float)
     return np.array([r.probes[name] for r in solution.history], dtype=float)
+
+
+def crushed_state(solution: Solution) -> StepRecord | None:
+    """The first state whose core lost ellipticity (``core_ellipticity`` ≤ 0), else None.
+
+    The 2D model writes the column (``reference2d/core_crushing.py``); without it, None.
+    """
+    for r in solution.history:
+        q = r.extra.get(CORE_ELLIPTICITY)
+        if isinstance(q, int | float) and not isinstance(q, bool) and q <= 0:
+            return r
+    return None
 
 
 def monotone_prefix(t: np.ndarray) -> int:

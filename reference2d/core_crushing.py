@@ -81,20 +81,23 @@ def ellipticity(F: np.ndarray, C: np.ndarray) -> np.ndarray:
     return smallest.min(axis=1)
 
 
-def smallest_ellipticity(F: np.ndarray, C: np.ndarray, first: int = 64) -> tuple[int, float]:
+def smallest_ellipticity(F: np.ndarray, C: np.ndarray, first: int = 64,
+                         stretch: np.ndarray | None = None) -> tuple[int, float]:
     """The index and value of the smallest :func:`ellipticity` over the points F, (m, 2, 2).
 
     q is evaluated only where its lower bound can beat the smallest value found:
     q(F) ≥ λ_min(FᵀF) · min_N λ_min(D(N)) + λ_min(S) (F D Fᵀ ≥ λ_min(D) F Fᵀ, N · S N ≥
     λ_min(S)); first on the ``first`` points of smallest bound, then on every point whose bound
-    lies below their minimum. The same answer as evaluating every point.
+    lies below their minimum. The same answer as evaluating every point. ``stretch``: the
+    points' :func:`principal_stretch`, where the caller has it.
     """
     E = 0.5 * (np.einsum("cki,ckj->cij", F, F) - np.eye(2))
     S = np.einsum("MJNL,cNL->cMJ", C, E)
     theta = np.linspace(0.0, np.pi, DIRECTIONS, endpoint=False)
     N = np.stack([np.cos(theta), np.sin(theta)], axis=1)
     d_min = np.linalg.eigvalsh(np.einsum("MJNL,tJ,tL->tMN", C, N, N))[:, 0].min()
-    bound = (principal_stretch(F) ** 2 * d_min
+    stretch = principal_stretch(F) if stretch is None else stretch
+    bound = (stretch**2 * d_min
              + np.linalg.eigvalsh(S)[:, 0])  # λ_min(FᵀF) = (smallest principal stretch)²
     order = np.argsort(bound)
     head = order[:first]
@@ -148,9 +151,9 @@ class CoreCrushing:
         self._system._set_u(u)
         if len(self._cells):
             F = np.eye(2) + self._grad.eval(self._cells).reshape(-1, 2, 2)  # F = I + ∇u
-            i, q = smallest_ellipticity(F, self._C)
-            local = (q / self._q0, float(principal_stretch(F).min()),
-                     *map(float, self._points[i]))
+            stretch = principal_stretch(F)
+            i, q = smallest_ellipticity(F, self._C, stretch=stretch)
+            local = (q / self._q0, float(stretch.min()), *map(float, self._points[i]))
         else:
             local = (np.inf, np.inf, 0.0, 0.0)
         everywhere = self._comm.allgather(local)

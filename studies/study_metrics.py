@@ -27,6 +27,7 @@ import math
 
 import numpy as np
 
+from comparisons.paths import crushed_state
 from comparisons.profiles import peak
 from sandwich.results import Solution
 from sandwich.scene import Scene
@@ -39,10 +40,6 @@ def _probe(scene: Scene, sol: Solution) -> str | None:
     if a.until_probe is not None:
         return a.until_probe
     return scene.probes[0].name if scene.probes else None
-
-
-def _number(v: object) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool)
 
 
 def _finite(v: float | None) -> float | None:
@@ -110,8 +107,7 @@ def case_metrics(scene: Scene, sol: Solution) -> dict[str, object]:
     out["peak_tau_core"] = _signed_peak(sol, ("tau_core",), 0.0)
     out["peak_tau_core_5mm"] = _signed_peak(sol, ("tau_core",), PEAK_WINDOW)
     out["contact_length"] = contact_length(sol)
-    crushed = next((r.load_factor for r in hist if _number(q := r.extra.get("core_ellipticity"))
-                    and q <= 0), None)
-    out["core_crushed_load"] = _finite(crushed)
+    crushed = crushed_state(sol)
+    out["core_crushed_load"] = _finite(crushed.load_factor) if crushed else None
     out["solve_seconds"] = round(float(sol.wall_seconds), 3)
     return out

@@ -226,7 +226,7 @@ def newton_correct(
     small_step = False  # the last correction passed the increment test
     first_small = None  # the iteration at which it first did
     contact_set = getattr(system, "contact_set", None)
-    flags, changed_at, extra = None, -1, 0  # the set, its last move to a new one, allowance
+    changed_at, extra = -1, 0  # the iteration of the set's last move to a new one; allowance
     seen: set[bytes] = set()  # every set this corrector met
     with np.errstate(all="ignore"):
         for it in itertools.count():
@@ -242,10 +242,10 @@ def newton_correct(
             if contact_set is not None:
                 now = np.asarray(contact_set(), dtype=bool)
                 key = np.packbits(now).tobytes()
-                if flags is not None and key not in seen:
+                if seen and key not in seen:
                     changed_at = it  # moved on to a set not met before: still settling
                 seen.add(key)
-                flags, extra = now, SETTLING_PER_PAIR * now.size
+                extra = SETTLING_PER_PAIR * now.size
             res = f_int - lam * f_ref
             r_norm = norm(res)
             if not math.isfinite(r_norm):
