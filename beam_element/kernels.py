@@ -479,14 +479,19 @@ def uses_sum_factorisation(op: LayerOperators) -> bool:
     on the tangent's flops, for force-only calls too: a force is the same with or without its
     tangent, bit for bit.
     """
+    key = (SUM_FACTORISATION, FACTORED_OVERHEAD)  # the decision, kept on ``op`` per setting
+    known = op.__dict__.get("_uses_sum_factorisation")
+    if known is not None and known[0] == key:
+        return known[1]
     if SUM_FACTORISATION == "never":
-        return False
-    fo = factored_operators(op)
-    if fo is None:
-        return False
-    if SUM_FACTORISATION == "always":
-        return True
-    return FACTORED_OVERHEAD * factored_flops(fo) < op.eta.size * point_flops(op)
+        use = False
+    else:
+        fo = factored_operators(op)
+        use = fo is not None and (
+            SUM_FACTORISATION == "always"
+            or FACTORED_OVERHEAD * factored_flops(fo) < op.eta.size * point_flops(op))
+    object.__setattr__(op, "_uses_sum_factorisation", (key, use))
+    return use
 
 
 def layer_flops(op: LayerOperators, tangent: bool = True) -> int:

@@ -132,6 +132,19 @@ def test_auto_takes_the_factored_kernel_for_enriched_cores_only(mode):
             assert kernels.layer_flops(op) * kernels.FACTORED_OVERHEAD < packed
 
 
+def test_the_kept_decision_follows_the_setting(mode):
+    """The decision is kept on the layer per setting: a changed setting is obeyed at once."""
+    op = _core("sublayers", 2)
+    for setting, expected in (("auto", True), ("never", False), ("always", True),
+                              ("auto", True)):
+        mode(setting)
+        assert kernels.uses_sum_factorisation(op) is expected
+    paper = _core("sublayers", 1)  # the rows factor, but auto keeps the packed kernel
+    for setting, expected in (("auto", False), ("always", True), ("auto", False)):
+        mode(setting)
+        assert kernels.uses_sum_factorisation(paper) is expected
+
+
 def _contact_state(model, rng):
     """Random state with every contact pair penetrating (as in test_beam_kernels)."""
     u = rng.normal(size=model.size) * 0.02
