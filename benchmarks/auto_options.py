@@ -33,6 +33,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -40,6 +42,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from core_levels import case_scene, reference  # noqa: E402
 
 from beam_element import run  # noqa: E402
+from beam_element.core_levels import LevelChoice  # noqa: E402
 from beam_element.model import build_model  # noqa: E402
 from beam_element.solve import _local_zone_elements, scene_model_options  # noqa: E402
 from sandwich.scene import CoreZone  # noqa: E402
@@ -54,18 +57,10 @@ FIELDS = ["case", "variant", "seconds", "error", "estimate", "estimate_from", "p
 def local_zones(scene: object, level: int) -> tuple[CoreZone, ...]:
     """``core_zones`` at ``level`` over the elements auto's nonlinear check always raises."""
     model = build_model(scene, elements=scene.beam_model.elements, **scene_model_options(scene))
-    inside = _local_zone_elements(scene, model)
-    x = model.mesh.x
-    zones, e, n = [], 0, inside.size
-    while e < n:
-        if not inside[e]:
-            e += 1
-            continue
-        start = e
-        while e < n and inside[e]:
-            e += 1
-        zones.append(CoreZone(start=float(x[start]), end=float(x[e]), level=level))
-    return tuple(zones)
+    levels = np.where(_local_zone_elements(scene, model), level, 1)
+    return tuple(CoreZone(start=z["start"], end=z["end"], level=z["level"])
+                 for z in LevelChoice(levels=levels, how="explicit").zones(model.mesh)
+                 if z["level"] > 1)
 
 
 def variant_scene(case: str, variant: str) -> object:
@@ -101,7 +96,6 @@ def measure(case: str, variant: str, repeat: int, ref: float) -> dict:
     passes = core["passes"]
     paths = sum(p["stage"].startswith("path step") for p in passes)
     checks = sum(p["stage"].startswith("end state") for p in passes)
-    last = passes[-1]["stage"] if passes else ""
     counts: dict[int, int] = {}
     for e in r.model.element_levels:
         counts[int(e)] = counts.get(int(e), 0) + 1
@@ -111,8 +105,7 @@ def measure(case: str, variant: str, repeat: int, ref: float) -> dict:
                 error=f"{100 * (lam / ref - 1):+.3f} %",
                 estimate="" if est is None else f"{100 * est:.2f} %",
                 estimate_from=("" if core["how"] != "auto" else
-                               "linear step only" if last.startswith("linear") or (
-                                   paths == 1 and checks == 0) else "nonlinear check"),
+                               "nonlinear check" if checks else "linear step only"),
                 passes=f"{paths} path(s), {checks} check(s)" if core["how"] == "auto" else "1 path",
                 steps=len(s.history) - 1, iterations=s.extra["total_newton_iterations"],
                 levels=" ".join(f"L{k}:{v}" for k, v in sorted(counts.items())), dofs=s.dofs,

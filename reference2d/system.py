@@ -164,8 +164,8 @@ class Reference2DSystem:
         self._setup_contact_nodes()
         self.A = self._create_matrix()
         self.b = fem_petsc.create_vector(self.R_form)
-        self.last_contact: list[ct.ContactState] = []
-        self._contact_last: list[ct.ContactState] = []  # of the last internal_force, per pair
+        self.last_contact: list[ct.ContactState] = []  # of the committed state
+        self._evaluated_contact: list[ct.ContactState] = []  # of the last internal_force
         self.counters = {"residuals": 0, "tangents": 0, "factorizations": 0,
                          "refactorizations": 0}
         self._mumps = MumpsSolver(self.comm)
@@ -195,7 +195,7 @@ class Reference2DSystem:
         with self.b.localForm() as b_local:
             b_local.set(0.0)
             states = self._contact_states(want_tangent=False)
-            self._contact_last = [state for state, _pair in states]
+            self._evaluated_contact = [state for state, _pair in states]
             if states:
                 f = np.zeros((self._nc, 2))
                 for state, _pair in states:
@@ -216,8 +216,8 @@ class Reference2DSystem:
         The Newton corrector lets an iteration whose set is still changing go on past its
         iteration limit (``sandwich/solver/newton.py``, "Contact-set settling").
         """
-        flags = [np.zeros(len(state.gap), dtype=bool) for state in self._contact_last]
-        for f, state in zip(flags, self._contact_last, strict=True):
+        flags = [np.zeros(len(state.gap), dtype=bool) for state in self._evaluated_contact]
+        for f, state in zip(flags, self._evaluated_contact, strict=True):
             f[state.active] = True
         return np.concatenate(flags) if flags else np.zeros(0, dtype=bool)
 
