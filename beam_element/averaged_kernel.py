@@ -184,12 +184,11 @@ def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw
         for i in range(ec):
             kb.unpack_element(i, Kuu, Kww, Kuw, pu, pw, ucols, wcols, scale, Ke)
             for k in range(n_xi):  # the B̄_x parts of eq. (24): b zᵀ + z bᵀ per ξ
-                for a in range(n):
-                    ba = Kx[i, k, 0, a]
-                    za = Kx[i, k, 1, a]
-                    for b in range(a, n):
-                        v = ba * Kx[i, k, 1, b] + za * Kx[i, k, 0, b]
-                        Ke[a, b] += v
-                        if b != a:
-                            Ke[b, a] += v
+                bk = Kx[i, k, 0]
+                zk = Kx[i, k, 1]
+                for a in range(n):  # the whole square, rows contiguous (vectorised): entry
+                    ba = bk[a]  # (b, a) is b_b z_a + z_b b_a, the same products as (a, b)'s
+                    za = zk[a]  # in the other order of one exact sum: the same bits
+                    for b in range(n):
+                        Ke[a, b] += ba * zk[b] + za * bk[b]
             kb.emit_block(e0 + i, Ke, K_out, slots, signs, data)
