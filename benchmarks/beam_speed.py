@@ -1,7 +1,8 @@
 """Beam model speed: one Newton iteration (60 … 7680 elements, core levels 1-4) and the fig. 5 path.
 
-Run: ``.venv/bin/python benchmarks/beam_speed.py [--quick] [--no-2d] [--convergence]``. Writes
-under ``benchmarks/results/beam/``:
+Run: ``.venv/bin/python benchmarks/beam_speed.py [--quick] [--no-2d] [--convergence]
+[--out DIR]``. Writes under ``benchmarks/results/beam/`` (or ``DIR``: another machine's tables
+beside the first one's, e.g. ``benchmarks/results/beam/machine_b``):
 
 - ``newton_iteration.{csv,md,png}``: one Newton iteration = internal force and tangent (eqs. 19,
   24-25 + contact, assembled into the eliminated DOFs, one pass) + factorisation + the two
@@ -477,6 +478,7 @@ def write_convergence(path_rows):
 
 
 def main():
+    global OUT
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("--quick", action="store_true", help="60..480 elements, levels 1-2")
     p.add_argument("--no-2d", action="store_true", help="skip the 2D runs of fig. 5")
@@ -488,7 +490,11 @@ def main():
                       help="only fig. 5's runs (fig5_speed.md), not the Newton iteration table")
     p.add_argument("--convergence", action="store_true",
                    help="also the fig. 5 λ(−15) convergence table (120 … 1920 elements)")
+    p.add_argument("--out", type=Path, default=None,
+                   help=f"folder for the tables (default {OUT.relative_to(ROOT)})")
     args = p.parse_args()
+    if args.out is not None:
+        OUT = args.out.resolve()
     counts = [60 * 2**k for k in range(4 if args.quick else 8)]  # 60 … 7680
     cases = [(n, 1) for n in counts]
     for level in ((2,) if args.quick else (2, 3, 4)):
