@@ -27,8 +27,8 @@ averaged along η), or by the NumPy path where its assumptions fail (:func:`supp
 
 Layers whose rows factor into x- and z-functions at a tensor rule are evaluated instead by the
 sum-factorised kernel of :mod:`beam_element.sum_factor` (same integrand, same points, ξ summed
-first) where that saves enough flops (:func:`uses_sum_factorisation`): the enriched cores
-(levels ≥ 2). The paper's layers keep the packed kernel below.
+first) where that saves enough flops (:func:`uses_sum_factorisation`): the cores, the paper's
+one included. The faces keep the packed kernel below.
 """
 
 from __future__ import annotations
@@ -463,10 +463,12 @@ _NO_DATA = np.empty(0)
 
 
 SUM_FACTORISATION = "auto"  # "auto" (by flops, below), "always" (where the rows factor), "never"
-# auto: factored when its flops × this < the packed kernel's. Measured (docs/beam_speed.md): at
-# the paper's core (2.2× fewer flops) the two take the same time, the factored kernel's smaller
-# GEMMs and gathers costing what its flops save; from level 2 on (5.6× and more) it is faster.
-FACTORED_OVERHEAD = 3.0
+# auto: factored when its flops × this < the packed kernel's. Measured (docs/beam_speed.md,
+# machine B, 2026-12-05): the paper's core (2.2× fewer flops) force + tangent 0.79-0.85 against
+# 1.0 ms at 240 elements, fig. 5's path 6-10 % faster; the paper's faces (1.4×) slower factored
+# (0.19 against 0.145 ms); from level 2 on (3.7× and more) factored is far faster. (3.0 until
+# then, from a measurement under load in which the paper's core tied.)
+FACTORED_OVERHEAD = 2.0
 
 
 def uses_sum_factorisation(op: LayerOperators) -> bool:
@@ -475,10 +477,11 @@ def uses_sum_factorisation(op: LayerOperators) -> bool:
     Only where the rows factor (tensor rule, every column an x-function times a z-function,
     checked); then by :data:`SUM_FACTORISATION`: ``"auto"`` takes it when its flops
     (:func:`~beam_element.sum_factor.factored_flops`) times :data:`FACTORED_OVERHEAD` are fewer
-    than the packed kernel's (:func:`point_flops` × G), i.e. the cores, not the faces. Decided
-    on the tangent's flops, for force-only calls too: a force is the same with or without its
-    tangent, bit for bit. Kept on ``op`` for the setting it was made under (the flop counts cost
-    ≈ 0.15 ms, and the kernels ask on every call); a changed setting is obeyed at once.
+    than the packed kernel's (:func:`point_flops` × G), i.e. the cores (the paper's one
+    included), not the faces. Decided on the tangent's flops, for force-only calls too: a
+    force is the same with or without its tangent, bit for bit. Kept on ``op`` for the
+    setting it was made under (the flop counts cost ≈ 0.15 ms, and the kernels ask on every
+    call); a changed setting is obeyed at once.
     """
     key = (SUM_FACTORISATION, FACTORED_OVERHEAD)  # the decision, kept on ``op`` per setting
     known = op.__dict__.get("_uses_sum_factorisation")

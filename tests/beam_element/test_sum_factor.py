@@ -118,14 +118,21 @@ def test_rows_that_do_not_factor_keep_the_packed_kernel(mode):
     assert factored_operators(face) is None
 
 
-def test_auto_takes_the_factored_kernel_for_enriched_cores_only(mode):
+def _paper_face():
+    """The paper's top face (no averaged membrane): its rows factor, at 1.4× fewer flops."""
+    return build_layer_operators("top", 0.5, 0.0, face_stiffness(KEVLAR),
+                                 gauss=EXACT_ORDER["top"])
+
+
+def test_auto_takes_the_factored_kernel_for_the_cores_only(mode):
+    """The cores (the paper's, 2.2× fewer flops, included) factored; the faces (1.4×) packed."""
     mode("auto")
     faces = [build_layer_operators(n, 0.5, 0.0, face_stiffness(KEVLAR), gauss=EXACT_ORDER[n])
              for n in ("top", "bottom")]
+    assert all(factored_operators(op) is not None for op in faces)  # they could be
     assert not any(kernels.uses_sum_factorisation(op) for op in faces)
-    assert not kernels.uses_sum_factorisation(_core("sublayers", 1))  # the paper's core
     for basis in ("sublayers", "polynomial"):
-        for level in (2, 3, 4):
+        for level in (1, 2, 3, 4):
             op = _core(basis, level)
             assert kernels.uses_sum_factorisation(op)
             packed = op.eta.size * kernels.point_flops(op)
@@ -139,10 +146,10 @@ def test_the_kept_decision_follows_the_setting(mode):
                               ("auto", True)):
         mode(setting)
         assert kernels.uses_sum_factorisation(op) is expected
-    paper = _core("sublayers", 1)  # the rows factor, but auto keeps the packed kernel
+    face = _paper_face()  # the rows factor, but auto keeps the packed kernel
     for setting, expected in (("auto", False), ("always", True), ("auto", False)):
         mode(setting)
-        assert kernels.uses_sum_factorisation(paper) is expected
+        assert kernels.uses_sum_factorisation(face) is expected
 
 
 def _contact_state(model, rng):
