@@ -161,8 +161,7 @@ class Kernel:
         """Run the kernel: the AOT function exported for exactly these types, else the JIT."""
         aot = self._aot
         if aot is None:  # this kernel's matchers, made on its first call (not every export's)
-            aot = self._aot = tuple((_matcher(spec), fn)
-                                    for spec, fn in _aot_exports().get(self.key, ()))
+            aot = self._aot = _own_exports(self.key)
         for matches, fn in aot:
             if matches(args):
                 return fn(*args)
@@ -264,6 +263,19 @@ def _aot_exports() -> dict[str, tuple]:
         return off(f"the ahead-of-time build did not load ({type(exc).__name__}: {exc})")
     _backend.update(backend="aot", reason=f"{sum(map(len, out.values()))} exported signatures")
     return out
+
+
+def _own_exports(key: str) -> tuple:
+    """((argument matcher, AOT function), ...) of kernel ``key``; () sends it to the JIT.
+
+    A manifest entry whose types cannot be read (a broken or foreign build) must not stop a
+    run, as a build that does not load does not (:func:`_aot_exports`): that kernel runs under
+    the JIT.
+    """
+    try:
+        return tuple((_matcher(spec), fn) for spec, fn in _aot_exports().get(key, ()))
+    except Exception:  # any malformed entry: the JIT is always there
+        return ()
 
 
 def _matcher(spec: list[list]) -> Callable[[tuple], bool]:

@@ -185,6 +185,21 @@ def test_a_call_the_build_does_not_cover_runs_the_jit():
     assert np.allclose(got32, np.abs(A.astype(np.float32)) @ np.abs(x[::2]), rtol=1e-6)
 
 
+def test_a_malformed_export_entry_runs_the_jit(monkeypatch):
+    """An entry whose types cannot be read must not stop a run (its kernel takes the JIT).
+
+    The matchers are made on a kernel's first call, outside :func:`jit._aot_exports`'s guard.
+    """
+    def never(*args):
+        raise AssertionError("an export with unreadable types was called")
+
+    kernel = jit.Kernel(lambda x: 2.0 * x, False)
+    monkeypatch.setattr(jit, "_aot_exports",
+                        lambda: {kernel.key: ((["no such kind"], never),)})
+    jit._KERNELS.remove(kernel)  # not one of the project's kernels
+    assert kernel(1.5) == 3.0
+
+
 @needs_build
 def test_the_build_runs_from_a_read_only_copy(tmp_path):
     """The packages copied with the build into a location nothing can be written to."""
