@@ -12,7 +12,7 @@ setup:
 	@bash scripts/setup.sh
 
 demo: setup
-	$(PY) -m sandwich_cli demo $(SCENE)
+	$(PY) -m sandwich.cli demo $(SCENE)
 
 test: setup
 	$(PY) -m pytest -q -m "not heavy"

@@ -12,7 +12,7 @@ user would set it in the scene (no code path that users cannot reach):
 - ``auto, max level 2``: ``max_core_level = 2``;
 - ``one pass, zones L3`` / ``L2``: ``auto`` with ``core_zones`` at the cap (3, or 2 with
   ``max_core_level = 2``) over every debond and load patch widened by a core thickness — the
-  elements auto's nonlinear check always raises (``beam_element.solve._local_zone_elements``).
+  elements auto's nonlinear check always raises (``sandwich.beam.solve._local_zone_elements``).
   With those zones at the cap the check has nothing to raise, so the path is followed once;
   the reported estimate is then the linear step's only (said in the table);
 - ``L1`` (the paper's core, what the speed targets were measured on), ``L2``, ``L3``: every
@@ -41,10 +41,10 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from core_levels import case_scene, reference  # noqa: E402
 
-from beam_element import run  # noqa: E402
-from beam_element.core_levels import LevelChoice  # noqa: E402
-from beam_element.model import build_model  # noqa: E402
-from beam_element.solve import _local_zone_elements, scene_model_options  # noqa: E402
+from sandwich.beam import run  # noqa: E402
+from sandwich.beam.core_levels import LevelChoice  # noqa: E402
+from sandwich.beam.model import build_model  # noqa: E402
+from sandwich.beam.solve import _local_zone_elements, scene_model_options  # noqa: E402
 from sandwich.scene import CoreZone  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "beam"

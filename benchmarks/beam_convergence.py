@@ -5,7 +5,7 @@ Run: ``.venv/bin/python benchmarks/beam_convergence.py --scene fig5 --until -5 -
 rows). Writes ``benchmarks/results/beam/convergence.csv``, ``convergence.md`` and
 ``convergence.png``.
 
-Variants: ``uniform`` / ``graded`` meshes (``beam_element.mesh.build_mesh``) with the paper's
+Variants: ``uniform`` / ``graded`` meshes (``sandwich.beam.mesh.build_mesh``) with the paper's
 element; ``*-averaged`` use ``face_membrane="averaged"`` (faces' ε_x averaged along each element:
 an option that departs from the paper, see docs/beam_vs_2d.md). λ at the target is read at the
 path's last step (the follower lands on the target), λ at w = −1 mm is interpolated.
@@ -25,7 +25,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from beam_element import run  # noqa: E402
+from sandwich.beam import run  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "beam"

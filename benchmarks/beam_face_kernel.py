@@ -1,4 +1,4 @@
-"""Averaged face membrane compiled (beam_element/averaged_kernel.py) vs its NumPy path.
+"""Averaged face membrane compiled (sandwich/beam/averaged_kernel.py) vs its NumPy path.
 
 Run: ``.venv/bin/python benchmarks/beam_face_kernel.py [--repeat 3]``. Writes
 ``benchmarks/results/beam/face_kernel.md``:
@@ -8,12 +8,12 @@ Run: ``.venv/bin/python benchmarks/beam_face_kernel.py [--repeat 3]``. Writes
   (linear solution scaled to 5 mm at mid-span): CPU seconds of the two face layers' force +
   tangent (assembled into the reduced CSR values) and of the whole force + tangent evaluation,
   with the faces' kernel time at ``face_membrane = "paper"`` (same faces otherwise) for scale;
-- whole paths (``beam_element.run``, CPU seconds, warm): fig. 5 at core levels 1 and 2 and at
+- whole paths (``sandwich.beam.run``, CPU seconds, warm): fig. 5 at core levels 1 and 2 and at
   the scene's default ``core = "auto"``, fig. 4 at its defaults; end λ and Newton iterations.
 
-"before" is the code path main had for these layers: :func:`beam_element.kernels.supports`
+"before" is the code path main had for these layers: :func:`sandwich.beam.kernels.supports`
 returning False for ``membrane_average`` layers, so the model evaluates them by
-:mod:`beam_element.element` (NumPy) and scatters the blocks; "after" is the compiled kernel.
+:mod:`sandwich.beam.element` (NumPy) and scatters the blocks; "after" is the compiled kernel.
 Both run in this process, alternately; times are best of ``--repeat``. Every table records
 ``uptime``'s load (2-core machine shared with other jobs).
 """
@@ -34,8 +34,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from beam_element import build_model, kernels, run  # noqa: E402
-from beam_element.element import layer_state, layer_tangent  # noqa: E402
+from sandwich.beam import build_model, kernels, run  # noqa: E402
+from sandwich.beam.element import layer_state, layer_tangent  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "beam"
@@ -155,8 +155,8 @@ def write(it_rows, p_rows, elements, repeat):
     OUT.mkdir(parents=True, exist_ok=True)
     md = [
         "Averaged face membrane (`face_membrane = \"averaged\"`, the default, with the stretch "
-        "faces) evaluated by the compiled kernel (`beam_element/averaged_kernel.py`, after) "
-        "against the NumPy path main used for it (`beam_element/element.py`, before), in one "
+        "faces) evaluated by the compiled kernel (`sandwich/beam/averaged_kernel.py`, after) "
+        "against the NumPy path main used for it (`sandwich/beam/element.py`, before), in one "
         f"process, alternately. CPU seconds (`time.process_time`), best of {repeat}. "
         "Written by `benchmarks/beam_face_kernel.py`.",
         "",
@@ -174,7 +174,7 @@ def write(it_rows, p_rows, elements, repeat):
             f"{r['face_paper'] * 1e3:.3f} | "
             f"{r['all_before'] * 1e3:.2f} | {r['all_after'] * 1e3:.2f} | "
             f"{r['all_before'] / r['all_after']:.1f}× | {r['K_rel']:.1e} | {r['load']} |")
-    md += ["", "## Whole paths (`beam_element.run`, warm, CPU s)", "",
+    md += ["", "## Whole paths (`sandwich.beam.run`, warm, CPU s)", "",
            "| path | CPU before (s) | CPU after (s) | speed-up | steps | "
            "Newton its (before/after) | λ end before | λ end after | relative Δλ | load |",
            "|---|---:|---:|---:|---:|---|---:|---:|---:|---|"]

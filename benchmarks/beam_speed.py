@@ -40,10 +40,10 @@ sys.path.insert(0, str(ROOT))
 
 from installed import write_bytecode  # noqa: E402  (benchmarks/, the script's folder)
 
-from beam_element import build_model, kernels, run  # noqa: E402
-from beam_element.core_levels import transfer  # noqa: E402
-from beam_element.model import BeamModel  # noqa: E402
-from beam_element.solve import scene_model_options  # noqa: E402
+from sandwich.beam import build_model, kernels, run  # noqa: E402
+from sandwich.beam.core_levels import transfer  # noqa: E402
+from sandwich.beam.model import BeamModel  # noqa: E402
+from sandwich.beam.solve import scene_model_options  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 from sandwich.solver.envelope import EnvelopeFactorization  # noqa: E402
 from sandwich.solver.jit import kernel_backend  # noqa: E402
@@ -358,7 +358,7 @@ def write_iterations(rows, reference, peak, before, after):
         f"state of the level-1 path at w_top_mid = {PATH_TARGET:g} mm on the same mesh, past "
         "the limit point, contact active, carried into levels 2-4 with zero enrichment "
         "amplitudes): internal force + consistent tangent "
-        "assembled into the free DOFs in one pass (numba kernels, `beam_element/kernels.py`), "
+        "assembled into the free DOFs in one pass (numba kernels, `sandwich/beam/kernels.py`), "
         "the contact pairs' closest-point projections included (computed afresh at every "
         "evaluation, as at a new iterate; until 2026-12-05 the repeated evaluations of one "
         "state reused them, ≈ 0.12 ms at 240 elements that the table left out), "

@@ -7,7 +7,7 @@ scaled to 5 mm at mid-span, contact active), the model's force + tangent with th
 (``kernels.SUM_FACTORISATION = "never"``, what main had) and with the default (``"auto"``: the
 sum-factorised kernel on enriched cores), measured alternately in the same process (best of 3,
 wall and thread CPU time), the factorisation and the corrector's two solves (the same for both),
-and the flops as executed (:func:`beam_element.kernels.layer_flops`). With ``--path``: the whole
+and the flops as executed (:func:`sandwich.beam.kernels.layer_flops`). With ``--path``: the whole
 path of each scene at its own settings (``core = "auto"`` by default), both ways, in process
 (``summary`` wall seconds).
 
@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT))
 
 from beam_speed import SCENE, deformed_state, dgemm_rate, load  # noqa: E402
 
-from beam_element import build_model, kernels, run  # noqa: E402
+from sandwich.beam import build_model, kernels, run  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 from sandwich.solver.envelope import EnvelopeFactorization  # noqa: E402
 
@@ -127,7 +127,7 @@ def write(rows, peak):
         ",".join(f"{r[k]:.6g}" if isinstance(r[k], float) else str(r[k]) for k in keys) + "\n"
         for r in rows))
     md = [
-        "Sum factorisation of the enriched core (`beam_element/sum_factor.py`), measured by "
+        "Sum factorisation of the enriched core (`sandwich/beam/sum_factor.py`), measured by "
         "`benchmarks/beam_sum_factor.py`. One Newton iteration of the fig. 5 scene (state: "
         "linear solution scaled to 5 mm at mid-span, contact active; core levels of the "
         "`sublayers` basis everywhere): force + consistent tangent assembled into the free "
@@ -182,7 +182,7 @@ def main():
 
 def write_paths(paths):
     """The whole-path table, ``sum_factor_paths.md``."""
-    md = ["Whole paths in process (`beam_element.run`, each scene's own settings: `core = "
+    md = ["Whole paths in process (`sandwich.beam.run`, each scene's own settings: `core = "
           "\"auto\"` unless the scene says otherwise), before (packed kernel everywhere, "
           "`never`) and after (`auto`), one run each, in this order. Solve wall = "
           "`summary.json` `wall_seconds`. Shared 2-core machine: the load is given per run.", "",

@@ -49,8 +49,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--elements", type=int, default=480)
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium"])
     args = ap.parse_args(argv)
-    import beam_element
-    import reference2d
+    import sandwich.beam
+    import sandwich.plane2d
 
     md = ["# Indentation under a patch load, bonded fig4 beam, linear (λ = 100 N)", "",
           f"benchmarks/beam_vs_2d_indentation.py; beam {args.elements} graded elements "
@@ -63,9 +63,9 @@ def main(argv: list[str] | None = None) -> int:
           "|---:|---:|---:|---:|" + "---:|" * len(args.levels) + "---:|---:|---:|"]
     for width in WIDTHS:
         s = scene_with_patch(width)
-        bt, bb = probes(beam_element.run(s, elements=args.elements,
+        bt, bb = probes(sandwich.beam.run(s, elements=args.elements,
                                          model_options={"face_membrane": "averaged"}).solution)
-        ref = [probes(reference2d.solve(s, level=lv)) for lv in args.levels]
+        ref = [probes(sandwich.plane2d.solve(s, level=lv)) for lv in args.levels]
         rt, rb = ref[-1]
         md.append(f"| {width:g} | {bt:.5f} | {bb:.5f} | {bt - bb:.5f} | "
                   + " | ".join(f"{t - b:.5f}" for t, b in ref)

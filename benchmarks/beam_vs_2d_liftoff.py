@@ -101,15 +101,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--elements", type=int, default=240)
     ap.add_argument("--level", default="coarse")
     args = ap.parse_args(argv)
-    import beam_element
-    import reference2d
+    import sandwich.beam
+    import sandwich.plane2d
 
     s = fig5_scene() if args.case == "fig5" else bending_scene()
     runs = {
-        "beam (paper)": lambda: beam_element.run(s, elements=args.elements).solution,
-        "beam (averaged)": lambda: beam_element.run(
+        "beam (paper)": lambda: sandwich.beam.run(s, elements=args.elements).solution,
+        "beam (averaged)": lambda: sandwich.beam.run(
             s, elements=args.elements, model_options={"face_membrane": "averaged"}).solution,
-        f"2d ({args.level})": lambda: reference2d.solve(s, level=args.level),
+        f"2d ({args.level})": lambda: sandwich.plane2d.solve(s, level=args.level),
     }
     md = [f"# Lift-off of the debonded top face: {s.name}", "",
           f"benchmarks/beam_vs_2d_liftoff.py {args.case}; beam {args.elements} graded elements, "

@@ -14,8 +14,8 @@ import time
 
 import numpy as np
 
-import beam_element
-import reference2d
+import sandwich.beam
+import sandwich.plane2d
 from sandwich.scene_file import load_scene
 
 path, until = sys.argv[1], float(sys.argv[2])
@@ -30,9 +30,9 @@ if load == "uniform":
     s = dataclasses.replace(s, loads=tuple(dataclasses.replace(ld, x=s.length / 2, width=s.length)
                                            for ld in s.loads))
 out = {}
-for name, fn in (("beam", lambda: beam_element.run(
+for name, fn in (("beam", lambda: sandwich.beam.run(
         s, elements=n, model_options={"face_membrane": "averaged"}).solution),
-                 ("2d", lambda: reference2d.solve(s, level=level))):
+                 ("2d", lambda: sandwich.plane2d.solve(s, level=level))):
     t = time.perf_counter()
     sol = fn()
     h = sol.history

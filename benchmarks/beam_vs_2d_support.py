@@ -9,8 +9,8 @@ mid-span, for both models. Throwaway experiment for docs/beam_vs_2d.md.
 import dataclasses
 import sys
 
-import beam_element
-import reference2d
+import sandwich.beam
+import sandwich.plane2d
 from sandwich.scene import Probe
 from sandwich.scene_file import load_scene
 
@@ -21,8 +21,8 @@ probes = tuple(Probe(f"w_{f}_{x:g}", f, x) for x in (0.0, 75.0, 150.0) for f in 
 an = dataclasses.replace(s.analysis, kind="linear", control="load", until_load_factor=100.0,
                          until_probe=None, until_value=None)
 s = dataclasses.replace(s, probes=probes, analysis=an)
-b = beam_element.run(s, elements=n).solution.history[-1].probes
-r = reference2d.solve(s, level=level).history[-1].probes
+b = sandwich.beam.run(s, elements=n).solution.history[-1].probes
+r = sandwich.plane2d.solve(s, level=level).history[-1].probes
 print(f"{'probe':14s} {'beam':>10s} {'2d':>10s} {'beam/2d':>8s}")
 for p in probes:
     print(f"{p.name:14s} {b[p.name]:10.5f} {r[p.name]:10.5f} {b[p.name] / r[p.name]:8.4f}")

@@ -3,8 +3,8 @@
 Run: ``.venv/bin/python benchmarks/contact_width.py [--scenes NAME ...] [--levels 1 auto]
 [--factors 1 10]``. Writes ``benchmarks/results/beam/contact_width.{md,csv}``.
 
-The penalty law of a debonded interface (``beam_element.contact.pressure_law``) is regularised
-over a width s (default ``beam_element.model.default_contact_smoothing``,
+The penalty law of a debonded interface (``sandwich.beam.contact.pressure_law``) is regularised
+over a width s (default ``sandwich.beam.model.default_contact_smoothing``,
 1e-6 mm on the shipped scenes). Newton converges linearly on pairs in the law's exponential
 tail (docs/beam_speed.md, "What bounds the rest"), which sets the iteration count of every
 debond scene. This benchmark solves each scene in this process with s × each factor
@@ -23,8 +23,8 @@ import os
 import time
 from pathlib import Path
 
-from beam_element import run
-from beam_element.model import BeamModel, default_contact_smoothing
+from sandwich.beam import run
+from sandwich.beam.model import BeamModel, default_contact_smoothing
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -41,7 +41,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from beam_element import run  # noqa: E402
+from sandwich.beam import run  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "beam"
@@ -103,7 +103,7 @@ def reference(case: str) -> tuple[float, str]:
 
 def solve_reference(case: str) -> None:
     """Solve the 2D model on the case and cache its end load (level: REFERENCE_LEVEL)."""
-    from reference2d import solve as solve2d
+    from sandwich.plane2d import solve as solve2d
 
     level = REFERENCE_LEVEL[case]
     t = time.perf_counter()

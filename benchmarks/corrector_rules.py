@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 import sandwich.solver.path as path_module
-from beam_element import run
+from sandwich.beam import run
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent

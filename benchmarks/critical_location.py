@@ -56,7 +56,7 @@ def case(length: float, how: str, fine: float, narrowed: bool):
 
 def first_bifurcation(scene):
     """The path's first bifurcation: a dict of what the table lists (None: no bifurcation)."""
-    from beam_element.solve import run
+    from sandwich.beam.solve import run
 
     t = time.perf_counter()
     r = run(scene)

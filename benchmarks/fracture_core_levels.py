@@ -4,9 +4,9 @@ Why does the beam's G move with the core level (docs/fracture.md "Beam core leve
 closed-form cases of ``tests/fracture/fracture_cases.py`` (peel couple, sliding couples,
 cantilever face slope), geometrically linear (λ = 1, one linear solve), this measures
 
-- the history columns' estimate (:func:`beam_element.fracture.tip_releases`: closure over
+- the history columns' estimate (:func:`sandwich.beam.fracture.tip_releases`: closure over
   Δ ≈ the face thickness, round(t/h) tip elements), and the closure of
-  :func:`beam_element.fracture.closure_release` over Δ = 1 (the one-element VCCT used until
+  :func:`sandwich.beam.fracture.closure_release` over Δ = 1 (the one-element VCCT used until
   2026-12-01), 2, 4, 8 tip elements;
 - the energy released by untying the tip node (Clapeyron, two linear solves at fixed load: the
   discrete model's own G over one element, independent of any closure formula),
@@ -41,10 +41,10 @@ from fracture_cases import (  # noqa: E402
     shear_loads,
 )
 
-from beam_element.constraints import NodeSupport, build_dof_map  # noqa: E402
-from beam_element.fracture import beam_tips, closure_release, tip_releases  # noqa: E402
-from beam_element.model import build_model  # noqa: E402
-from beam_element.solve import linear_solution  # noqa: E402
+from sandwich.beam.constraints import NodeSupport, build_dof_map  # noqa: E402
+from sandwich.beam.fracture import beam_tips, closure_release, tip_releases  # noqa: E402
+from sandwich.beam.model import build_model  # noqa: E402
+from sandwich.beam.solve import linear_solution  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "fracture"
 CLOSURES = (1, 2, 4, 8)

@@ -4,7 +4,7 @@ For each scene both models follow the scene's own path; each converged step's hi
 ``G_<debond>_<tip>``, ``GI_…``, ``GII_…`` (N/mm). The table compares them at common values of the
 scene's until-probe (interpolation of √G in each model's path, within the range both reached);
 the plot overlays G, G_I and G_II against that probe. The 2D model also reports the domain
-J-integral (``reference2d.jintegral``, disc of 4 face thicknesses) as a cross-check of its G.
+J-integral (``sandwich.plane2d.jintegral``, disc of 4 face thicknesses) as a cross-check of its G.
 
 Run: ``XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/fracture_paths.py [--level medium]
 [--scenes fig5 c2 c3] [--reuse-2d] [--core 1]``. Writes
@@ -39,12 +39,12 @@ J_RADIUS_FACES = 4.0  # 2D J-integral disc radius / face thickness
 
 def _solve(scene, model: str, level: str):
     if model == "beam":
-        from beam_element.solve import solve
+        from sandwich.beam.solve import solve
         return solve(scene)
-    from reference2d.fracture import VcctEvaluator
-    from reference2d.jintegral import JIntegral
-    from reference2d.model import interface_z
-    from reference2d.solve import solve
+    from sandwich.plane2d.fracture import VcctEvaluator
+    from sandwich.plane2d.jintegral import JIntegral
+    from sandwich.plane2d.model import interface_z
+    from sandwich.plane2d.solve import solve
 
     sol = solve(scene, level=level, keep_states=True)
     model, states = sol.reference2d_states
@@ -141,7 +141,7 @@ def main() -> None:
         lines = [f"# G along the path: {scene.name}", "",
                  f"Beam: {sols['beam'].extra.get('elements')} elements, core "
                  f"{scene.beam_model.core}, closure over Δ ≈ the thinner face "
-                 f"thickness (beam_element.fracture.closure_elements). 2D: level {args.level}, "
+                 f"thickness (sandwich.beam.fracture.closure_elements). 2D: level {args.level}, "
                  f"{sols['2d'].extra.get('cells')} cells, VCCT closure length "
                  f"{sols['2d'].extra.get('vcct_closure_length')} mm, J-integral disc radius "
                  f"{sols['2d'].extra.get('j_radius')} mm. "

@@ -6,7 +6,7 @@ each model's ``summary.json`` / ``history.csv``) and writes one table:
 Run: ``.venv/bin/python benchmarks/gallery_agreement.py DIR`` → writes
 ``benchmarks/results/comparisons/gallery_agreement.{md,csv}`` (``--out`` to change the stem).
 
-The rows and the table are :mod:`comparisons.agreement` (its docstring names the columns).
+The rows and the table are :mod:`sandwich.compare.agreement` (its docstring names the columns).
 The trust column is not computed: it is the documented reading of each scene (``TRUST`` below,
 sources named there).
 """
@@ -21,7 +21,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from comparisons.agreement import fine_check, markdown, scene_row  # noqa: E402
+from sandwich.compare.agreement import fine_check, markdown, scene_row  # noqa: E402
 
 # Where the 2D model is (not) a trustworthy reference, per scene, and why. Sources: README "How
 # far to trust it" (Green-strain core crushing under concentrated loads), docs/comparisons.md

@@ -76,7 +76,7 @@ def followed(scene, how: str, fine: float, narrowed: bool):
 
 def first_maximum(scene):
     """The path's first load maximum: a dict of what the table lists (load None: none)."""
-    from beam_element.solve import run
+    from sandwich.beam.solve import run
 
     t = time.perf_counter()
     r = run(scene)

@@ -1,6 +1,6 @@
-"""Peak memory of the ``sandwich`` commands against the guard's estimate (models/memory.py).
+"""Peak memory of the ``sandwich`` commands against the guard's estimate (sandwich.models.memory).
 
-Every row runs the real command line (``python -m sandwich_cli solve|mesh ... --quiet``) on a
+Every row runs the real command line (``python -m sandwich.cli solve|mesh ... --quiet``) on a
 variant of ``scenes/default.toml`` in its own process and reads that process's peak resident set
 size from ``os.wait4`` (``ru_maxrss``, the kernel's high-water mark of the whole process), read
 by a small launcher process (:data:`LAUNCHER`). The
@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 OUT = ROOT / "benchmarks" / "results" / "memory"
 UNTIL = -0.5  # mm: a short path (a handful of steps)
 
-# Rows: (role, ...). "fit" rows set the constants of models/memory.py (least squares on the
+# Rows: (role, ...). "fit" rows set the constants of sandwich/models/memory.py (least squares on the
 # relative error, printed by this script); "check" rows are predicted by that fit, not fitted.
 BEAM_ROWS = [  # (role, elements, core)
     ("fit", 2000, "1"), ("fit", 4000, "1"), ("fit", 8000, "1"),
@@ -112,7 +112,7 @@ def _solve_info(folder: Path) -> dict:
 
 def run_rows(have: list[dict]) -> list[dict]:
     """Measure every row not in ``have`` (each in a fresh temporary folder); all rows."""
-    py = [sys.executable, "-m", "sandwich_cli"]
+    py = [sys.executable, "-m", "sandwich.cli"]
     done = {_row_id(r): r for r in have}
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -176,7 +176,7 @@ def scene_of(row: dict):
 def estimate_of(row: dict, states: int | None = None) -> float | None:
     """The estimate (bytes) for the scene and command of ``row``, with ``states`` kept states
     (default: the scene's step budget, as the guard assumes)."""
-    from models import memory
+    from sandwich.models import memory
 
     if row["kind"] == "import":
         return None
@@ -185,13 +185,13 @@ def estimate_of(row: dict, states: int | None = None) -> float | None:
 
 
 def fit(rows: list[dict]) -> dict[str, float]:
-    """Least squares (relative error) of the constants of models/memory.py on the "fit" rows.
+    """Least squares (relative error) of the constants of sandwich.models.memory, "fit" rows.
 
     Each row's kept states (8 bytes a DOF each, at the steps it took) are taken off first.
     """
     import numpy as np
 
-    from models import memory
+    from sandwich.models import memory
 
     def solve(kind, feature):
         A, y = [], []
@@ -217,7 +217,7 @@ def fit(rows: list[dict]) -> dict[str, float]:
 
 def table(rows: list[dict], meta: dict, constants: dict[str, float]) -> str:
     """Markdown table: measured peak RSS next to the estimate."""
-    from models import memory
+    from sandwich.models import memory
 
     mib = 2**20
     now = {k: getattr(memory, k) for k in constants}
@@ -231,7 +231,8 @@ def table(rows: list[dict], meta: dict, constants: dict[str, float]) -> str:
              "in the last column); peak RSS = `ru_maxrss` of the command's process "
              f"(`os.wait4`). Scene: `scenes/default.toml`; beam rows to w_top_mid = {UNTIL} mm, "
              "2D solve rows 2 steps (`max_steps = 2`).", "",
-             "Estimate (`models/memory.py`) at the states the run kept (the fit) and as the guard "
+             "Estimate (`sandwich.models.memory`) at the states the run kept (the fit) and as "
+             "the guard "
              "judges it, with every step of the scene's budget kept (`max_steps = 400` for the "
              "beam rows). Role *fit*: the row set the constants; *check*: predicted, not fitted.",
              "",
@@ -256,7 +257,7 @@ def table(rows: list[dict], meta: dict, constants: dict[str, float]) -> str:
             f"| {what} | {res} | {r['role']} | {r.get('steps') or ''} | {r.get('dofs') or ''} "
             f"| {rss:.0f} | {est / mib:.0f} | {est / r['peak_rss_bytes']:.2f} | "
             f"{guard / mib:.0f} | {r['wall_s']:.1f} | {load} |")
-    lines += ["", "Constants fitted to the *fit* rows (in `models/memory.py`: "
+    lines += ["", "Constants fitted to the *fit* rows (in `sandwich/models/memory.py`: "
               + ", ".join(f"`{k}` = {v:.4g}" + ("" if math.isclose(v, now[k], rel_tol=0.01)
                                                  else f" (module: {now[k]:.4g})")
                           for k, v in constants.items()) + ")."]

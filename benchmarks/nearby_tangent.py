@@ -4,7 +4,7 @@ Run: ``.venv/bin/python benchmarks/nearby_tangent.py [--scenes NAME ...] [--leve
 Writes ``benchmarks/results/beam/nearby_tangent.{md,csv}``.
 
 Each scene is solved in this process (kernels warm) twice per core setting, alternately: with
-:meth:`beam_element.model.BeamModel.internal_force_nearby` (as shipped) and with it removed
+:meth:`sandwich.beam.model.BeamModel.internal_force_nearby` (as shipped) and with it removed
 from the class (the corrector then evaluates every iterate in full, as before). Recorded: solve
 wall time (``Solution.wall_seconds``), steps, Newton iterations, the end load and the largest
 relative difference of the load factor over the two histories (equal step counts only).
@@ -18,8 +18,8 @@ import os
 import time
 from pathlib import Path
 
-from beam_element import run
-from beam_element.model import BeamModel
+from sandwich.beam import run
+from sandwich.beam.model import BeamModel
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reference2d import solve
+from sandwich.plane2d import solve
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]

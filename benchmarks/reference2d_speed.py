@@ -68,8 +68,8 @@ def run(name: str, level: str, full: bool, until: float = UNTIL) -> dict:
     """Solve one scene at one level in this process (every rank) and return rank 0's timings."""
     from mpi4py import MPI
 
-    from reference2d import contact as ct
-    from reference2d import solve
+    from sandwich.plane2d import contact as ct
+    from sandwich.plane2d import solve
     from sandwich.scene_file import load_scene
 
     scene = load_scene(ROOT / "scenes" / f"{name}.toml")
@@ -78,7 +78,7 @@ def run(name: str, level: str, full: bool, until: float = UNTIL) -> dict:
                                                                         until_value=until))
     timers = Timers()
     models = []
-    solve_mod = sys.modules["reference2d.solve"]  # (the package exports a function `solve`)
+    solve_mod = sys.modules["sandwich.plane2d.solve"]  # (the package exports a function `solve`)
     build, mesh_fn, evaluate = solve_mod.build_model, solve_mod.build_scene_mesh, ct.evaluate
 
     def build_timed(*a, **k):

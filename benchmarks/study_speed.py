@@ -25,9 +25,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from studies.study import run_study  # noqa: E402
-from studies.study_file import load_study  # noqa: E402
-from studies.study_report import crossings  # noqa: E402
+from sandwich.studies.study import run_study  # noqa: E402
+from sandwich.studies.study_file import load_study  # noqa: E402
+from sandwich.studies.study_report import crossings  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "studies"
 

@@ -5,7 +5,8 @@
 - results: :mod:`sandwich.results` (types, writers, readers, a result's identity);
 - the generic path-following solver: :mod:`sandwich.solver`; a progress display.
 
-Every model (``beam_element``, ``meshes`` + ``reference2d``) and tool above them may import this
+Every model (``sandwich.beam``, ``sandwich.meshes`` + ``sandwich.plane2d``) and tool above them may
+import this
 package; it imports no model, no registry, no comparison, no command line
 (``tests/test_layers.py``).
 """

@@ -36,9 +36,9 @@ def _workload() -> None:
     """Evaluate every kernel the shipped scenes reach, at small sizes."""
     import numpy as np
 
-    from beam_element import build_model, run
-    from beam_element import kernels as K
-    from beam_element.solve import scene_model_options
+    from sandwich.beam import build_model, run
+    from sandwich.beam import kernels as K
+    from sandwich.beam.solve import scene_model_options
     from sandwich.scene_file import load_scene
     from sandwich.solver import envelope
 

@@ -43,5 +43,5 @@ fi
 # containers and CI images have) never writes it, and every run would compile ≈ 70 modules
 # again (≈ 60 ms per `sandwich solve`, 20 ms of them inside the solve's lazy imports). Quick
 # when nothing changed (compileall skips up-to-date files).
-.venv/bin/python -m compileall -q beam_element comparisons meshes models reference2d sandwich \
-    sandwich_cli studies >/dev/null || echo "setup: WARNING: compileall failed (runs compile on import)"
+.venv/bin/python -m compileall -q sandwich \
+    >/dev/null || echo "setup: WARNING: compileall failed (runs compile on import)"

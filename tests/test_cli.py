@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from sandwich_cli import main
+from sandwich.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -111,9 +111,9 @@ def test_library_log_lines_are_held_back_unless_verbose():
 def test_warnings_before_a_solve(tmp_path):
     import dataclasses
 
+    from sandwich.cli.commands import warnings_before_solve
     from sandwich.scene import Analysis, Load
     from sandwich.scene_file import load_scene
-    from sandwich_cli.commands import warnings_before_solve
 
     scene = load_scene(ROOT / "scenes" / "default.toml")
     assert warnings_before_solve(scene, "beam") == []
@@ -128,7 +128,7 @@ def test_an_internal_error_names_its_crash_log_and_leaves_the_current_folder_cle
         tmp_path, monkeypatch, capsys):
     import re
 
-    from sandwich_cli import commands
+    from sandwich.cli import commands
 
     def broken(args):
         raise RuntimeError("a bug")
@@ -158,7 +158,7 @@ def test_ctrl_c_in_a_real_solve_keeps_the_converged_steps(tmp_path):
     out = tmp_path / "r"
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "sandwich_cli", "solve", str(ROOT / "scenes" / "default.toml"),
+        [sys.executable, "-m", "sandwich.cli", "solve", str(ROOT / "scenes" / "default.toml"),
          "--model", "beam", "--out", str(out)],
         cwd=tmp_path, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env,
         # as a terminal's foreground job: a suite started in the background (`make test &`)

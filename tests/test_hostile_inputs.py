@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from sandwich_cli import main
+from sandwich.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT = (ROOT / "scenes" / "default.toml").read_text()

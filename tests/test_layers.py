@@ -8,28 +8,52 @@ import ast
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-# package -> the project packages it may import (the order of docs/architecture.md)
+# layer -> the layers it may import (the order of docs/architecture.md). The contract is the
+# ``sandwich`` package's own modules, ``sandwich.results`` and ``sandwich.solver``; every other
+# subpackage of ``sandwich`` is a layer of its own.
 ALLOWED = {
     "sandwich": set(),
-    "beam_element": {"sandwich"},
-    "meshes": {"sandwich"},
-    "reference2d": {"sandwich", "meshes"},
-    "models": {"sandwich", "beam_element", "meshes", "reference2d"},
-    "comparisons": {"sandwich", "models"},
-    "studies": {"sandwich", "beam_element", "meshes", "reference2d", "models", "comparisons"},
-    "sandwich_cli": {"sandwich", "meshes", "models", "comparisons", "studies"},
+    "sandwich.beam": {"sandwich"},
+    "sandwich.meshes": {"sandwich"},
+    "sandwich.plane2d": {"sandwich", "sandwich.meshes"},
+    "sandwich.models": {"sandwich", "sandwich.beam", "sandwich.meshes", "sandwich.plane2d"},
+    "sandwich.compare": {"sandwich", "sandwich.models"},
+    "sandwich.studies": {"sandwich", "sandwich.beam", "sandwich.meshes", "sandwich.plane2d",
+                         "sandwich.models", "sandwich.compare"},
+    "sandwich.cli": {"sandwich", "sandwich.meshes", "sandwich.models", "sandwich.compare",
+                     "sandwich.studies"},
 }
-PACKAGES = set(ALLOWED)
+LAYERS = set(ALLOWED)
+
+
+def _layer(module):
+    """The layer a dotted module name belongs to (None: not the project's)."""
+    parts = module.split(".")
+    if parts[0] != "sandwich":
+        return None
+    if len(parts) > 1 and "sandwich." + parts[1] in LAYERS:
+        return "sandwich." + parts[1]
+    return "sandwich"
 
 
 def _modules():
-    for pkg in ALLOWED:
-        for path in sorted((ROOT / pkg).rglob("*.py")):
-            rel = path.relative_to(ROOT).with_suffix("")
-            parts = list(rel.parts)
-            if parts[-1] == "__init__":
-                parts = parts[:-1]
-            yield ".".join(parts), path
+    for path in sorted((ROOT / "sandwich").rglob("*.py")):
+        rel = path.relative_to(ROOT).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        yield ".".join(parts), path
+
+
+def test_one_top_level_package():
+    """Nothing but ``sandwich`` is installed: no other folder of the project is a package."""
+    import tomllib
+
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert cfg["tool"]["setuptools"]["packages"]["find"]["include"] == ["sandwich*"]
+    others = sorted(p.parent.name for p in ROOT.glob("*/__init__.py")
+                    if p.parent.name not in ("sandwich", "benchmarks"))
+    assert not others, others
 
 
 def _imports(path):
@@ -44,10 +68,10 @@ def _imports(path):
 def test_every_import_points_down_the_layers():
     wrong = []
     for name, path in _modules():
-        pkg = name.split(".")[0]
+        layer = _layer(name)
         for target in _imports(path):
-            top = target.split(".")[0]
-            if top in PACKAGES and top != pkg and top not in ALLOWED[pkg]:
+            top = _layer(target)
+            if top is not None and top != layer and top not in ALLOWED[layer]:
                 wrong.append(f"{path.relative_to(ROOT)} imports {target}")
     assert not wrong, "\n".join(wrong)
 

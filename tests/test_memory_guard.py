@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from models import memory, registry
+from sandwich.cli import main
+from sandwich.models import memory, registry
 from sandwich.scene_file import load_scene
-from sandwich_cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT = ROOT / "scenes" / "default.toml"
@@ -95,7 +95,7 @@ def test_a_run_that_cannot_fit_is_refused_before_any_work(tmp_path, monkeypatch,
 
 
 def test_the_refusal_is_the_estimate_against_what_is_available(monkeypatch):
-    from sandwich_cli.memory_guard import check_memory
+    from sandwich.cli.memory_guard import check_memory
 
     scene = load_scene(DEFAULT)
     need = memory.estimate(scene, "beam").peak_bytes
@@ -125,7 +125,7 @@ def test_a_close_run_is_warned_about_and_still_runs(tmp_path, monkeypatch, capsy
 
 @pytest.mark.parametrize("path", sorted(glob.glob(str(ROOT / "scenes" / "*.toml"))))
 def test_the_shipped_scenes_pass_with_4_gb(path, monkeypatch):
-    from sandwich_cli.memory_guard import check_memory
+    from sandwich.cli.memory_guard import check_memory
 
     _available(monkeypatch, 4e9)
     scene = load_scene(path)
@@ -139,7 +139,7 @@ def test_a_study_whose_cases_cannot_fit_is_refused(tmp_path, monkeypatch, capsys
     tiny = (ROOT / "tests" / "study" / "tiny.toml").read_text()
     study.write_text(tiny.replace('"../../scenes/', f'"{ROOT}/scenes/')
                      .replace("elements = 60", "elements = 20000"))
-    from studies.study_file import load_study
+    from sandwich.studies.study_file import load_study
 
     one = max(memory.estimate(c.scene, "beam").peak_bytes for c in load_study(study).cases)
     _available(monkeypatch, 1.5 * one)  # one case would fit, two workers not
@@ -194,7 +194,7 @@ def test_a_small_real_beam_run_is_within_a_factor_2_of_its_estimate(tmp_path, mo
 
     scene = _scene_with(tmp_path, "\n[beam_model]\nelements = 600\ncore = 3\n")
     scene.write_text(scene.read_text().replace("value = -8", "value = -0.1"))
-    run = _benchmark().measure([sys.executable, "-m", "sandwich_cli", "solve", str(scene),
+    run = _benchmark().measure([sys.executable, "-m", "sandwich.cli", "solve", str(scene),
                                 "--model", "beam", "--out", str(tmp_path / "o"), "--quiet"],
                                tmp_path)
     assert run["exit"] == 0, run["stderr"]

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 
-from beam_element.dofs import global_dof
-from beam_element.solve import run
+from sandwich.beam.dofs import global_dof
+from sandwich.beam.solve import run
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent

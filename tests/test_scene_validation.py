@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
+from sandwich.cli import main
 from sandwich.scene import Debond, SceneError
 from sandwich.scene_file import load_scene
-from sandwich_cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 SHIPPED = sorted(glob.glob(str(ROOT / "scenes" / "*.toml")))

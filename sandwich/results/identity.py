@@ -51,7 +51,8 @@ def scene_digest(scene: object) -> str:
 def _digest_of(root: str, packages: tuple[str, ...]) -> str:
     h = hashlib.sha256()
     for pkg in packages:
-        for path in sorted((Path(root) / pkg).rglob("*.py")):
+        top = Path(root) / pkg
+        for path in [top] if top.is_file() else sorted(top.rglob("*.py")):
             h.update(str(path.relative_to(root)).encode())
             h.update(b"\0")
             h.update(path.read_bytes())
@@ -60,7 +61,8 @@ def _digest_of(root: str, packages: tuple[str, ...]) -> str:
 
 
 def source_digest(root: Path, packages: Iterable[str]) -> str:
-    """SHA-256 of the ``*.py`` sources of ``packages`` under ``root`` (read once per process)."""
+    """SHA-256 of the ``*.py`` sources of ``packages`` (folders or files) under ``root`` (read once per
+    process)."""
     return _digest_of(str(Path(root).resolve()), tuple(packages))
 
 

@@ -1,6 +1,6 @@
 """Numba for the compiled kernels, with an on-disk cache that also works from a read-only install.
 
-Compiled kernels (``beam_element.kernels``, :mod:`sandwich.solver.envelope`) are decorated with
+Compiled kernels (``sandwich.beam.kernels``, :mod:`sandwich.solver.envelope`) are decorated with
 :func:`njit`, i.e. ``numba.njit(cache=True)``: the machine code is written to disk on the first
 call and loaded (not recompiled) by every later process. Where the cache lives:
 
@@ -45,7 +45,7 @@ from pathlib import Path
 __all__ = ["Kernel", "cache_directory", "kernel_backend", "kernels", "njit"]
 
 _HERE = Path(__file__).resolve()
-_SOURCE_DIRS = (_HERE.parent, _HERE.parents[2] / "beam_element")  # the kernels' source dirs
+_SOURCE_DIRS = (_HERE.parent, _HERE.parents[1] / "beam")  # the kernels' source dirs
 
 
 def _writable(path: Path) -> bool:
@@ -221,6 +221,8 @@ def manifest_mismatch(manifest: dict) -> str:
         return "this machine's CPU cannot be identified (no /proc/cpuinfo)"
     if manifest.get("machine") != here:
         return "the ahead-of-time build is for another machine or Python/numpy"
+    if not all((ROOT / rel).is_file() for rel in manifest.get("files", ())):
+        return "a kernel source of the ahead-of-time build is no longer there"
     if manifest.get("sources") != source_digest(manifest["files"]):
         return "a kernel source changed since the ahead-of-time build"
     return ""

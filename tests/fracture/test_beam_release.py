@@ -1,4 +1,4 @@
-"""Energy release rate of the beam model (beam_element.fracture) against closed form.
+"""Energy release rate of the beam model (sandwich.beam.fracture) against closed form.
 
 References: the beam-theory / J-integral closed forms of ``fracture_cases`` (derived there) and,
 independently of the VCCT formula, the energy released by untying the tip node (a virtual
@@ -18,10 +18,10 @@ from fracture_cases import (
     shear_loads,
 )
 
-from beam_element.constraints import NodeSupport, build_dof_map
-from beam_element.dofs import NODE_DOFS
-from beam_element.fracture import beam_tips, column_names, tip_releases
-from beam_element.solve import linear_solution, run
+from sandwich.beam.constraints import NodeSupport, build_dof_map
+from sandwich.beam.dofs import NODE_DOFS
+from sandwich.beam.fracture import beam_tips, column_names, tip_releases
+from sandwich.beam.solve import linear_solution, run
 
 
 def _release(sc, tip="end"):
@@ -123,10 +123,10 @@ def test_virtual_extension_energy_converges_to_the_closed_form():
 def test_mixed_core_levels_at_the_tip_are_flagged_and_auto_keeps_the_tip_uniform():
     """A level-2 zone ending 2 mm past the tip of the sliding case (x = 60) puts a level change
     next to the tip: the summary says so. "auto" levels every tip zone
-    (:func:`beam_element.fracture.uniform_tip_levels`), so it has no such warning."""
+    (:func:`sandwich.beam.fracture.uniform_tip_levels`), so it has no such warning."""
     import dataclasses
 
-    from beam_element.fracture import LEVEL_NEIGHBOURHOOD
+    from sandwich.beam.fracture import LEVEL_NEIGHBOURHOOD
     from sandwich.scene import CoreZone
 
     sc = scene(shear_loads(scene(peel_loads())), probe_on="bottom", elements=480, core=1)
@@ -170,12 +170,12 @@ def test_g_does_not_drift_with_a_uniform_core_level(case):
 
 def test_a_uniform_level_over_the_tip_zone_removes_the_patch_bias():
     """A level-2 patch of 5 elements each side of the tip biases G; levelling the tip zone
-    (half a core thickness each side, beam_element.fracture.uniform_tip_levels) brings G back
+    (half a core thickness each side, sandwich.beam.fracture.uniform_tip_levels) brings G back
     to the uniform-level value. Measured (480 el.): sliding 0.973 → 0.995 (uniform level 2:
     0.9965), level-4 patch 0.937 → 0.990; peel 0.961 → 0.995.
     """
-    from beam_element.fracture import level_warning, uniform_tip_levels
-    from beam_element.model import build_model
+    from sandwich.beam.fracture import level_warning, uniform_tip_levels
+    from sandwich.beam.model import build_model
 
     sc = scene(shear_loads(scene(peel_loads())), probe_on="bottom", elements=480)
     base = build_model(sc)

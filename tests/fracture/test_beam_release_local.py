@@ -1,6 +1,6 @@
 """The closure's tie reactions from the elements next to the tips only (``_closure_support``).
 
-:func:`beam_element.fracture.tip_releases` evaluates the layers of the elements whose forces
+:func:`sandwich.beam.fracture.tip_releases` evaluates the layers of the elements whose forces
 reach the tie reactions it reads (and every contact pair), not the whole beam. Reference: the
 same closure on the full internal force (``full_response`` over every element), at converged
 states of the fig. 5 scene (top debond, two tips, contact closed over it) at the paper's core
@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from beam_element.fracture import _closure, beam_tips, closure_elements, tip_releases
-from beam_element.solve import run
+from sandwich.beam.fracture import _closure, beam_tips, closure_elements, tip_releases
+from sandwich.beam.solve import run
 from sandwich.scene_file import load_scene
 
 SCENE = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
@@ -57,7 +57,7 @@ def test_the_restricted_force_is_the_full_one_at_the_tip_nodes_only():
     f_full = model.full_response(u_full, tangent=False)[0]
     some = np.array([10, 11, 12])
     f_some = model.full_response(u_full, tangent=False, elements=some)[0]
-    from beam_element.fracture import tie_dofs
+    from sandwich.beam.fracture import tie_dofs
 
     inner = tie_dofs("top", 12)[0]  # node 12: elements 11 and 12, both kept
     assert np.allclose(f_some[inner], f_full[inner], rtol=1e-12, atol=0.0)
@@ -68,7 +68,7 @@ def test_the_restricted_force_is_the_full_one_at_the_tip_nodes_only():
 
 
 def test_the_history_takes_the_paths_columns_without_evaluating_them_again(monkeypatch):
-    import beam_element.fracture as fracture
+    import sandwich.beam.fracture as fracture
 
     calls = []
     real = fracture.tip_releases

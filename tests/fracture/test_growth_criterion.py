@@ -5,7 +5,7 @@ import dataclasses
 import pytest
 from fracture_cases import peel_g, peel_loads, scene
 
-from beam_element.solve import run
+from sandwich.beam.solve import run
 from sandwich.fracture import bk_toughness, growth_onset
 from sandwich.results import StepRecord
 from sandwich.scene import Toughness

@@ -12,8 +12,8 @@ import json
 import pytest
 from fracture_cases import peel_g, peel_loads, scene
 
-from models import run_model
 from sandwich.fracture import growth_onset, missing_releases
+from sandwich.models import run_model
 from sandwich.results import Solution, StepRecord, load_result, write_solution
 
 COLS = ("G_0_end", "GI_0_end", "GII_0_end")
@@ -42,7 +42,7 @@ def _rows(folder):
 
 def _check_interrupted_against_complete(model, sc, tmp_path, after=3):
     full = run_model(sc, model, tmp_path / "full")
-    from models.registry import get_model
+    from sandwich.models.registry import get_model
 
     with pytest.raises(KeyboardInterrupt):
         run_model(sc, model, tmp_path / "cut", solver=_interrupting(get_model(model).solve, after))
@@ -109,7 +109,7 @@ def test_linear_2d_run_leaves_g_empty_and_says_why():
     """
     import dataclasses
 
-    from reference2d import solve
+    from sandwich.plane2d import solve
 
     sc = scene(peel_loads())
     lin = dataclasses.replace(sc, analysis=dataclasses.replace(sc.analysis, kind="linear"))

@@ -1,4 +1,4 @@
-"""Energy release rate of the 2D reference (reference2d.fracture) against closed form.
+"""Energy release rate of the 2D reference (sandwich.plane2d.fracture) against closed form.
 
 References: the closed forms of ``fracture_cases`` (beam theory / J-integral of the steady
 state, derived there). The closure length Δ is a physical length: G must not depend on it (the
@@ -22,7 +22,7 @@ pytestmark = pytest.mark.dolfinx
 
 
 def _solve(sc, level="coarse"):
-    from reference2d.solve import solve
+    from sandwich.plane2d.solve import solve
 
     sol = solve(sc, level=level, keep_states=True)
     assert sol.converged, sol.message
@@ -31,7 +31,7 @@ def _solve(sc, level="coarse"):
 
 
 def _g(model, state, closure_length, tip="end"):
-    from reference2d.fracture import VcctEvaluator
+    from sandwich.plane2d.fracture import VcctEvaluator
 
     ev = VcctEvaluator(model, closure_length)
     assert [(t.debond, t.tip) for t in ev.tips] == [(0, tip)]  # the other end: open mouth
@@ -70,7 +70,7 @@ def test_peel_couple_matches_closed_form_over_a_4x_range_of_closure_length(peel)
     assert sol.history[-1].extra["GI_0_end"] + sol.history[-1].extra["GII_0_end"] == \
         pytest.approx(gs[0].G, rel=1e-12)
     # the domain J-integral, independent of the lips' forces and openings (disc of 8 mm)
-    from reference2d.jintegral import JIntegral
+    from sandwich.plane2d.jintegral import JIntegral
 
     j = JIntegral(model, 60.0, 0.5 * sc.core.thickness, 1.0, 8.0).evaluate(state[2])
     assert j == pytest.approx(exact, rel=0.02)
@@ -97,7 +97,7 @@ def test_cantilever_face_slope_of_root_g_matches_beam_theory():
 
 
 def test_opening_interpolation_is_exact_for_quadratics():
-    from reference2d.fracture import opening_at
+    from sandwich.plane2d.fracture import opening_at
 
     r = np.array([0.5, 1.0, 1.6, 2.2])  # two edges: (0, 0.5, 1.0), (1.0, 1.6, 2.2)
     f = np.column_stack([r * (3 - r), 2 * r**2])  # quadratics vanishing at the tip
@@ -141,9 +141,9 @@ def test_j_integral_equals_vcct_along_the_fig5_buckling_path():
     Measured (benchmarks/results/fracture/fig5_medium.md): J/G 1.003 ... 0.981 wherever G is
     past the face's buckling; the path runs through large rotations of the peeling face.
     """
-    from reference2d.fracture import VcctEvaluator
-    from reference2d.jintegral import JIntegral
-    from reference2d.solve import solve
+    from sandwich.plane2d.fracture import VcctEvaluator
+    from sandwich.plane2d.jintegral import JIntegral
+    from sandwich.plane2d.solve import solve
     from sandwich.scene_file import load_scene
 
     root = Path(__file__).resolve().parents[2]

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from meshes import build_mesh
+from sandwich.meshes import build_mesh
 from sandwich.scene_file import load_scene
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"

@@ -5,8 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from meshes import build_mesh
-from meshes.q9 import cell_areas
+from sandwich.meshes import build_mesh
+from sandwich.meshes.q9 import cell_areas
 from sandwich.scene import Debond, Load, Probe
 
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from meshes.layered_mesh import LAYER_TAGS
-from meshes.q9 import NODES, cell_areas, gauss_points, jacobian_determinants
+from sandwich.meshes.layered_mesh import LAYER_TAGS
+from sandwich.meshes.q9 import NODES, cell_areas, gauss_points, jacobian_determinants
 
 
 def test_every_shipped_scene_meshes_at_coarse(coarse_meshes):

@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from meshes import quality_report, write_mesh
+from sandwich.meshes import quality_report, write_mesh
 
 
 @pytest.fixture(scope="module")

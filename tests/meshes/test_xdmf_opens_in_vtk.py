@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from meshes import build_mesh, write_mesh
+from sandwich.meshes import build_mesh, write_mesh
 from sandwich.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -112,8 +112,8 @@ import dataclasses, sys
 import numpy as np
 sys.path.insert(0, {root!r})
 from sandwich.solver import jit
-from beam_element import build_model, run
-from beam_element.solve import scene_model_options
+from sandwich.beam import build_model, run
+from sandwich.beam.solve import scene_model_options
 from sandwich.scene_file import load_scene
 scene = load_scene({scene!r})
 out = {{}}
@@ -170,7 +170,7 @@ def test_aot_build_equals_the_jit_bit_for_bit_without_importing_numba(tmp_path):
 @needs_build
 def test_a_call_the_build_does_not_cover_runs_the_jit():
     """float32 values and a strided vector: no exported signature; the JIT gives the answer."""
-    from beam_element import kernels
+    from sandwich.beam import kernels
 
     rng = np.random.default_rng(0)
     A = (rng.standard_normal((6, 6)) > 0.5) * rng.standard_normal((6, 6))
@@ -204,9 +204,9 @@ def test_a_malformed_export_entry_runs_the_jit(monkeypatch):
 def test_the_build_runs_from_a_read_only_copy(tmp_path):
     """The packages copied with the build into a location nothing can be written to."""
     site = tmp_path / "site"
-    for pkg in ("sandwich", "beam_element"):
+    for pkg in ("sandwich",):
         shutil.copytree(ROOT / pkg, site / pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    for d in (site / "sandwich" / "solver", site / "beam_element"):
+    for d in (site / "sandwich" / "solver", site / "sandwich" / "beam"):
         (d / "__pycache__").write_text("not a directory")
     code = ("import sys, numpy as np, scipy.sparse as sp\n"
             "from sandwich.solver import envelope, jit\n"

@@ -6,7 +6,7 @@ needed more than ``desired_iterations``: the target is then reached by ordinary 
 critical point instead of by the target's control from before it. Toy: the von Mises truss
 behind a spring (its load maximum changes the inertia 0 → 1, tests/solver/solver_toys.py);
 the trial's iteration count is set by the test. The beam's case (fig. 7 c1 at 120 elements):
-tests/beam_element/test_step_independence.py.
+tests/beam/test_step_independence.py.
 """
 
 import numpy as np

@@ -464,7 +464,7 @@ def test_kernels_run_from_a_read_only_install(tmp_path):
 
     root = Path(__file__).resolve().parents[2]
     site = tmp_path / "site"
-    for pkg in ("sandwich", "beam_element"):
+    for pkg in ("sandwich",):
         shutil.copytree(root / pkg, site / pkg, ignore=shutil.ignore_patterns("__pycache__"))
     code = ("import os, numpy as np, scipy.sparse as sp\n"
             "from sandwich.solver import jit\n"
@@ -477,7 +477,7 @@ def test_kernels_run_from_a_read_only_install(tmp_path):
                XDG_CACHE_HOME=str(tmp_path / "nohome" / ".cache"), PYTHONDONTWRITEBYTECODE="1")
     # read-only: without root, chmod; with root (mode bits ignored), a file where the cache dirs
     # would go blocks them just as well
-    for d in (site / "sandwich" / "solver", site / "beam_element"):
+    for d in (site / "sandwich" / "solver", site / "sandwich" / "beam"):
         (d / "__pycache__").write_text("not a directory")
     (tmp_path / "nohome").write_text("not a directory")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,

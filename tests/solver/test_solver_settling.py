@@ -106,7 +106,7 @@ def test_the_scene_key_is_two_by_default_and_not_an_analysis_option():
 def test_the_beam_path_takes_fewer_steps_to_the_same_end_state():
     """fig. 9 d10, the paper's core at 60 elements: a nearly linear path whose correctors settle
     contact pairs after their increment has converged."""
-    from beam_element import run
+    from sandwich.beam import run
     scene = load_scene(SCENES / "paper-fig9-clamped-d10.toml")
     scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
         scene.beam_model, core=1, core_zones=(), elements=60, settling_allowance=None))
@@ -121,7 +121,7 @@ def test_the_beam_path_takes_fewer_steps_to_the_same_end_state():
 def test_an_allowance_of_max_iterations_is_the_controller_without_it():
     """docs/scenes.md: a value at or above [analysis] max_iterations turns it off — the same
     states as without the allowance (fig. 9 d10, the paper's core, 60 elements)."""
-    from beam_element import run
+    from sandwich.beam import run
     scene = load_scene(SCENES / "paper-fig9-clamped-d10.toml")
     scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
         scene.beam_model, core=1, core_zones=(), elements=60, settling_allowance=None))
@@ -184,7 +184,7 @@ def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends
     buckling is cut as BENT; with its state kept after the retry the path takes that state as
     a step, spends fewer corrector iterations, and ends at the equilibrium the path without
     the kept state (HALF_REACH = 0: never taken) ends at."""
-    from beam_element import run
+    from sandwich.beam import run
     from sandwich.solver import path as path_module
     scene = load_scene(SCENES / "paper-fig5-top-debond-40-load-top.toml")
     scene = dataclasses.replace(scene, beam_model=dataclasses.replace(

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
+from sandwich.cli import main
 from sandwich.scene_file import load_scene
-from sandwich_cli import main
-from studies.study_file import StudyError, load_study
+from sandwich.studies.study_file import StudyError, load_study
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
@@ -151,8 +151,8 @@ def test_periodic_debonds_reproduce_the_papers_fig9_scenes(tmp_path, d):
 
 
 def test_derived_ratios_match_the_extremes_maps_scene_transformations(tmp_path):
-    """The study's derived parameters against the typed transformations of studies.extremes."""
-    from studies import extremes
+    """The study's derived parameters against the typed transformations of the extremes sweep."""
+    from benchmarks.sweeps import extremes
 
     base = load_scene(FIG5)
     for derived, sweep, value in (("core_stiffness_ratio", "stiffness", 1e-3),
@@ -183,7 +183,7 @@ def _close(a, b):
 @pytest.mark.parametrize("sweep", ["stiffness", "thickness", "slenderness", "debond", "load"])
 def test_the_extremes_studies_hold_the_maps_sweeps_and_build_its_scenes(sweep):
     """The shipped extremes-<sweep> study against the map's own typed transformations."""
-    from studies import extremes
+    from benchmarks.sweeps import extremes
 
     study = load_study(ROOT / "studies" / "shipped" / f"extremes-{sweep}.toml")
     assert study.check_all and study.timeout and study.max_cells

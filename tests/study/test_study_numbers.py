@@ -10,10 +10,10 @@ import pytest
 
 from sandwich.results import LimitPoint, Profile, Solution, StepRecord
 from sandwich.scene_file import load_scene
-from studies.study_check import check_errors, corners, select_checks
-from studies.study_file import load_study
-from studies.study_metrics import case_metrics, contact_length
-from studies.study_report import crossings, rows
+from sandwich.studies.study_check import check_errors, corners, select_checks
+from sandwich.studies.study_file import load_study
+from sandwich.studies.study_metrics import case_metrics, contact_length
+from sandwich.studies.study_report import crossings, rows
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]

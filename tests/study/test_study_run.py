@@ -18,11 +18,11 @@ from pathlib import Path
 
 import pytest
 
-from sandwich_cli import main
-from studies import study_case
-from studies.study import run_study
-from studies.study_file import load_study
-from studies.study_run import Progress
+from sandwich.cli import main
+from sandwich.studies import study_case
+from sandwich.studies.study import run_study
+from sandwich.studies.study_file import load_study
+from sandwich.studies.study_run import Progress
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
@@ -41,7 +41,7 @@ def _finished(out):
 
 def test_killed_study_resumes_reusing_every_finished_case(tmp_path, capsys):
     out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "sandwich_cli", "study", str(RESUME), "--out", str(out),
+    cmd = [sys.executable, "-m", "sandwich.cli", "study", str(RESUME), "--out", str(out),
            "--workers", "1"]
     proc = subprocess.Popen(cmd, cwd=ROOT, start_new_session=True, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
@@ -146,7 +146,7 @@ def test_a_case_over_the_wall_time_cap_keeps_its_converged_steps(tmp_path, monke
 
     from distributed import Client, LocalCluster
 
-    from models import registry
+    from sandwich.models import registry
     from sandwich.results import Solution, StepRecord
 
     spec = registry.MODELS["beam"]
@@ -187,7 +187,7 @@ def test_the_indicator_of_a_load_controlled_case_is_its_compliance_change():
     factors, which a load target fixes."""
     import dataclasses
 
-    from beam_element import run
+    from sandwich.beam import run
     from sandwich.scene import Analysis
     from sandwich.scene_file import load_scene
 

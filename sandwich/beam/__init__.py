@@ -1,0 +1,17 @@
+"""The paper's high-order sandwich beam element with debonds and contact (NumPy/SciPy only).
+
+Public API
+----------
+solve(scene, progress=None) -> sandwich.results.Solution
+run(scene, progress=None, elements=None) -> BeamRun (solution, model, converged states)
+build_model(scene, elements=None, gauss=None, contact_penalty=None) -> BeamModel
+profile_columns(model, u, nonlinear=True) / section_fields(model, u) / layer_grid(...)
+"""
+
+from sandwich.beam.dofs import DOF_NAMES, DOF_TABLE
+from sandwich.beam.fields import SectionFields, layer_grid, profile_columns, section_fields
+from sandwich.beam.model import BeamModel, build_model
+from sandwich.beam.solve import BeamRun, linear_solution, run, solve
+
+__all__ = ["DOF_NAMES", "DOF_TABLE", "BeamModel", "BeamRun", "SectionFields", "build_model",
+           "layer_grid", "linear_solution", "profile_columns", "run", "section_fields", "solve"]
