@@ -1,7 +1,7 @@
 """What the default ``core = "auto"`` costs against what it could cost: fig. 5 and the demo scene.
 
-Run: ``.venv/bin/python benchmarks/auto_options.py`` (``--cases fig5 demo``, ``--repeat 2``);
-writes ``benchmarks/results/beam/auto_options.{csv,md}``.
+Run from the project root: ``python -m benchmarks.auto_options`` (``--cases fig5 demo``,
+``--repeat 2``, ``--out DIR``); writes ``benchmarks/results/beam/auto_options.{csv,md}``.
 
 Issue 12 asks for fig. 5 "at the default settings" in ≤ 0.4 s; the default core is ``auto``,
 which follows the path at least twice (docs/beam_element.md, "Core levels"). This benchmark
@@ -29,25 +29,20 @@ import argparse
 import csv
 import dataclasses
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "benchmarks"))
+from benchmarks.core_levels import case_scene, reference
+from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from sandwich.beam import run
+from sandwich.beam.core_levels import LevelChoice
+from sandwich.beam.model import build_model
+from sandwich.beam.solve import _local_zone_elements, scene_model_options
+from sandwich.scene import CoreZone
 
-from core_levels import case_scene, reference  # noqa: E402
-
-from sandwich.beam import run  # noqa: E402
-from sandwich.beam.core_levels import LevelChoice  # noqa: E402
-from sandwich.beam.model import build_model  # noqa: E402
-from sandwich.beam.solve import _local_zone_elements, scene_model_options  # noqa: E402
-from sandwich.scene import CoreZone  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 VARIANTS = ("auto", "auto, max level 2", "one pass, zones L3", "one pass, zones L2", "L1", "L2",
             "L3")
 FIELDS = ["case", "variant", "seconds", "error", "estimate", "estimate_from", "passes",
@@ -112,9 +107,9 @@ def measure(case: str, variant: str, repeat: int, ref: float) -> dict:
                 lambda_end=f"{lam:.6g}", load=f"{load:.2f}")
 
 
-def write(rows: list[dict], refs: dict[str, tuple[float, str]]) -> None:
-    OUT.mkdir(parents=True, exist_ok=True)
-    with open(OUT / "auto_options.csv", "w", newline="") as fh:
+def write(rows: list[dict], refs: dict[str, tuple[float, str]], out: Path, stamp: str) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "auto_options.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, FIELDS)
         w.writeheader()
         w.writerows(rows)
@@ -124,7 +119,7 @@ def write(rows: list[dict], refs: dict[str, tuple[float, str]]) -> None:
              "the 2D reference; `estimate`: what the run reports about itself (`estimate_from`:",
              "a nonlinear end-state check, or the linear step only — which does not see the",
              "buckled debond). Machine: " + os.uname().machine + f", {os.cpu_count()} cores; "
-             "`load`: 1-min load average when the row started.", ""]
+             "`load`: 1-min load average when the row started.", "", stamp, ""]
     for case, (ref, where) in refs.items():
         lines += [f"## {case} (reference λ = {ref:.6g}, {where})", "",
                   "| variant | seconds | error | estimate | from | passes | steps | Newton its "
@@ -137,7 +132,7 @@ def write(rows: list[dict], refs: dict[str, tuple[float, str]]) -> None:
                              f"{r['steps']} | {r['iterations']} | {r['levels']} | {r['dofs']} | "
                              f"{r['load']} |")
         lines.append("")
-    (OUT / "auto_options.md").write_text("\n".join(lines))
+    (out / "auto_options.md").write_text("\n".join(lines))
 
 
 def main() -> None:
@@ -145,7 +140,9 @@ def main() -> None:
     p.add_argument("--cases", nargs="+", default=["fig5", "demo"], choices=["fig5", "demo"])
     p.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS)
     p.add_argument("--repeat", type=int, default=2)
+    add_out_argument(p, OUT)
     a = p.parse_args()
+    stamp = measured_on()
     rows, refs = [], {}
     for case in a.cases:
         refs[case] = reference(case)
@@ -154,7 +151,7 @@ def main() -> None:
             r = rows[-1]
             print(f"{case} {variant}: {r['seconds']} s, {r['error']}, {r['passes']}, "
                   f"{r['levels']} [load {r['load']}]", flush=True)
-    write(rows, refs)
+    write(rows, refs, a.out, stamp)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Averaged face membrane compiled (sandwich/beam/averaged_kernel.py) vs its NumPy path.
 
-Run: ``.venv/bin/python benchmarks/beam_face_kernel.py [--repeat 3]``. Writes
-``benchmarks/results/beam/face_kernel.md``:
+Run from the project root: ``python -m benchmarks.beam_face_kernel [--repeat 3] [--out DIR]``.
+Writes ``benchmarks/results/beam/face_kernel.md``:
 
 - per Newton iteration, at the fig. 5 scene's defaults (stretch faces, ``face_membrane =
   "averaged"``, closest-point contact), 240 elements, core levels 1 and 2, at a nonlinear state
@@ -23,22 +23,18 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import sys
 import time
 from contextlib import contextmanager
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.beam import build_model, kernels, run
+from sandwich.beam.element import layer_state, layer_tangent
+from sandwich.scene_file import load_scene
 
-from sandwich.beam import build_model, kernels, run  # noqa: E402
-from sandwich.beam.element import layer_state, layer_tangent  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 FIG5 = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
 FIG4 = ROOT / "scenes" / "paper-fig4-bonded-3pb.toml"
 _SUPPORTS = kernels.supports
@@ -151,9 +147,9 @@ def path_rows(cases, repeat):
     return rows
 
 
-def write(it_rows, p_rows, elements, repeat):
-    OUT.mkdir(parents=True, exist_ok=True)
-    md = [
+def write(it_rows, p_rows, elements, repeat, out=OUT, stamp=""):
+    out.mkdir(parents=True, exist_ok=True)
+    md = [stamp, "",
         "Averaged face membrane (`face_membrane = \"averaged\"`, the default, with the stretch "
         "faces) evaluated by the compiled kernel (`sandwich/beam/averaged_kernel.py`, after) "
         "against the NumPy path main used for it (`sandwich/beam/element.py`, before), in one "
@@ -185,7 +181,7 @@ def write(it_rows, p_rows, elements, repeat):
             f"{r['cpu_before'] / r['cpu_after']:.2f}× | {r['steps_after']} | "
             f"{r['its_before']}/{r['its_after']} | {r['lam_before']:.10f} | "
             f"{r['lam_after']:.10f} | {d:.1e} | {r['load']} |")
-    (OUT / "face_kernel.md").write_text("\n".join(md) + "\n")
+    (out / "face_kernel.md").write_text("\n".join(md) + "\n")
     print("\n".join(md))
 
 
@@ -193,13 +189,15 @@ def main():
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--elements", type=int, default=240)
+    add_out_argument(p, OUT)
     args = p.parse_args()
+    stamp = measured_on()
     it_rows = iteration_rows((1, 2), args.elements, args.repeat)
     cases = [("fig. 5, core level 1", FIG5, 1), ("fig. 5, core level 2", FIG5, 2),
              ("fig. 5, defaults (core auto)", FIG5, None), ("fig. 4, defaults", FIG4, None)]
     run(load_scene(FIG4))  # warm-up: numba cache load, imports
     p_rows = path_rows(cases, args.repeat)
-    write(it_rows, p_rows, args.elements, args.repeat)
+    write(it_rows, p_rows, args.elements, args.repeat, args.out, stamp)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,8 @@
 """Beam model speed: one Newton iteration (60 … 7680 elements, core levels 1-4) and the fig. 5 path.
 
-Run: ``.venv/bin/python benchmarks/beam_speed.py [--quick] [--no-2d] [--convergence]
-[--out DIR]``. Writes under ``benchmarks/results/beam/`` (or ``DIR``: another machine's tables
-beside the first one's, e.g. ``benchmarks/results/beam/machine_b``):
+Run from the project root: ``python -m benchmarks.beam_speed [--quick] [--no-2d]
+[--convergence] [--out DIR]``. Writes under ``benchmarks/results/beam/`` (a rerun replaces the
+tables; each says the machine and date it was measured on) or ``DIR``:
 
 - ``newton_iteration.{csv,md,png}``: one Newton iteration = internal force and tangent (eqs. 19,
   24-25 + contact, assembled into the eliminated DOFs, one pass) + factorisation + the two
@@ -27,7 +27,6 @@ import json
 import os
 import statistics
 import subprocess
-import sys
 import tempfile
 import time
 from functools import partial
@@ -35,22 +34,19 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.installed import write_bytecode
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, console_script, measured_on
+from sandwich.beam import build_model, kernels, run
+from sandwich.beam.core_levels import transfer
+from sandwich.beam.model import BeamModel
+from sandwich.beam.solve import scene_model_options
+from sandwich.scene_file import load_scene
+from sandwich.solver.envelope import EnvelopeFactorization
+from sandwich.solver.jit import kernel_backend
+from sandwich.solver.newton import _solve_both
+from sandwich.solver.sparse import SparseFactorization
 
-from installed import write_bytecode  # noqa: E402  (benchmarks/, the script's folder)
-
-from sandwich.beam import build_model, kernels, run  # noqa: E402
-from sandwich.beam.core_levels import transfer  # noqa: E402
-from sandwich.beam.model import BeamModel  # noqa: E402
-from sandwich.beam.solve import scene_model_options  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
-from sandwich.solver.envelope import EnvelopeFactorization  # noqa: E402
-from sandwich.solver.jit import kernel_backend  # noqa: E402
-from sandwich.solver.newton import _solve_both  # noqa: E402
-from sandwich.solver.sparse import SparseFactorization  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 SCENE = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
 
 
@@ -225,7 +221,7 @@ def cli_run(model: str, repeat: int, auto: bool = False, level: str | None = Non
             scene.write_text(SCENE.read_text() + extra)
             t = time.perf_counter()
             level_args = [] if level is None else ["--level", level]
-            p = subprocess.run([str(ROOT / ".venv" / "bin" / "sandwich"), "solve", str(scene),
+            p = subprocess.run([str(console_script("sandwich")), "solve", str(scene),
                                 "--model", model, "--quiet", "--out", tmp, *level_args],
                                capture_output=True, text=True, cwd=ROOT, env=env)
             whole = time.perf_counter() - t
@@ -258,6 +254,7 @@ def paired_ratios(n: int) -> list[dict[str, float]]:
 
 def fig5_speed(repeat, with_2d):
     write_bytecode()  # the CLI runs start from the installed state (benchmarks/installed.py)
+    stamp = measured_on()
     before = load()
     t_new, s_new = in_process_path(False, repeat)
     t_ref, s_ref = in_process_path(True, repeat)
@@ -281,6 +278,8 @@ def fig5_speed(repeat, with_2d):
         "closest-point contact): with the paper's core (`[beam_model] core = 1`) and as "
         "shipped (`core = \"auto\"`: core levels chosen and checked by passes of the path and "
         "end-state checks; fig. 5: two passes, two checks).",
+        "",
+        stamp,
         "",
         f"2 cores: {before} before, {after} after (this benchmark's own runs included; "
         "other jobs, if any, inflate the times). Times are best of the runs.",
@@ -346,7 +345,7 @@ def fig5_speed(repeat, with_2d):
     print("\n".join(lines))
 
 
-def write_iterations(rows, reference, peak, before, after):
+def write_iterations(rows, reference, peak, before, after, stamp):
     OUT.mkdir(parents=True, exist_ok=True)
     keys = list(rows[0])
     (OUT / "newton_iteration.csv").write_text(
@@ -367,6 +366,8 @@ def write_iterations(rows, reference, peak, before, after):
         "GEMMs (strains/stresses and scatter not counted), the factorisation and the solves, "
         "exactly as executed. Peak: this machine's "
         f"measured single-thread DGEMM rate, {peak / 1e9:.1f} GF/s.",
+        "",
+        stamp,
         "",
         f"2 cores: {before} at the start, {after} at the end (this benchmark's own work "
         "included; other jobs, if any, inflate the times).",
@@ -456,7 +457,7 @@ def richardson_limit(path_rows):
     return l3 - d2 * d2 / (d1 - d2), float(np.log2(d1 / d2))
 
 
-def write_convergence(path_rows):
+def write_convergence(path_rows, stamp):
     ref, order = richardson_limit(path_rows)
     md = ["| elements | wall (s) | steps | Newton iterations | final λ | λ vs limit | "
           "converged | max penetration (mm) |", "|---:|---:|---:|---:|---:|---:|---|---:|"]
@@ -473,7 +474,8 @@ def write_convergence(path_rows):
         "load (N) at the target deflection; fixing the deflection and converging λ is the "
         "same statement as converging the deflection at that load. Limit: Aitken "
         f"extrapolation of the last three counts, λ∞ = {ref:.6g} N (observed order "
-        f"{order:.2f}). {load()} at the end (shared machine).\n\n" + "\n".join(md) + "\n\n"
+        f"{order:.2f}). {load()} at the end (shared machine).\n\n{stamp}\n\n" + "\n".join(md)
+        + "\n\n"
         + verdict + "\n")
 
 
@@ -490,27 +492,26 @@ def main():
                       help="only fig. 5's runs (fig5_speed.md), not the Newton iteration table")
     p.add_argument("--convergence", action="store_true",
                    help="also the fig. 5 λ(−15) convergence table (120 … 1920 elements)")
-    p.add_argument("--out", type=Path, default=None,
-                   help=f"folder for the tables (default {OUT.relative_to(ROOT)})")
+    add_out_argument(p, OUT)
     args = p.parse_args()
-    if args.out is not None:
-        OUT = args.out.resolve()
+    OUT = args.out.resolve()
     counts = [60 * 2**k for k in range(4 if args.quick else 8)]  # 60 … 7680
     cases = [(n, 1) for n in counts]
     for level in ((2,) if args.quick else (2, 3, 4)):
         top = 7680 if level == 2 else 1920  # memory: level 4 at 7680 el. is ~0.5 M DOFs
         cases += [(n, level) for n in counts if n <= top]
     if not args.fig5_only:
-        before = load()
+        stamp, before = measured_on(), load()
         peak = dgemm_rate()
         rows = newton_iteration_times(cases, repeat=3)
         reference = (240, reference_iteration(240, 3))
-        write_iterations(rows, reference, peak, before, load())
+        write_iterations(rows, reference, peak, before, load(), stamp)
     if args.iterations_only:
         return
     fig5_speed(1 if args.quick else 3, with_2d=not args.no_2d)
     if args.convergence:
-        write_convergence(fig5_path([120, 240, 360, 480, 960, 1920]))
+        stamp = measured_on()
+        write_convergence(fig5_path([120, 240, 360, 480, 960, 1920]), stamp)
 
 
 if __name__ == "__main__":

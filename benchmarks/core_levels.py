@@ -1,8 +1,10 @@
 """Core levels of the beam against the 2D reference: end-of-path load, error, wall time.
 
-Run: ``.venv/bin/python benchmarks/core_levels.py --case fig5 --variants L1 L2 L3 auto``
-(appends rows to ``benchmarks/results/beam/core_levels.csv``) and ``--report`` (writes
-``core_levels.md`` and ``core_levels.png`` from every row).
+Run from the project root: ``python -m benchmarks.core_levels --case fig5 --variants L1 L2 L3
+auto`` (appends rows to ``benchmarks/results/beam/core_levels.csv``, each with the machine and
+date it was measured on) and ``--report`` (writes ``core_levels.md`` and ``core_levels.png`` from
+every row); ``--out DIR`` for another folder (the 2D references stay cached in
+``benchmarks/results/beam/core_levels_2d.json``).
 
 Cases (scene, target, 2D reference):
 
@@ -34,18 +36,23 @@ import csv
 import dataclasses
 import json
 import os
-import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import (
+    RESULTS,
+    ROOT,
+    add_out_argument,
+    append_row,
+    machine_and_date,
+    measured_line,
+    measured_on,
+)
+from sandwich.beam import run
+from sandwich.scene_file import load_scene
 
-from sandwich.beam import run  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "beam"
-TRADEOFF = ROOT / "benchmarks" / "results" / "comparisons" / "tradeoff.csv"
+OUT = RESULTS / "beam"
+TRADEOFF = RESULTS / "comparisons" / "tradeoff.csv"
 CASES = {
     "bend": ("paper-fig4-bonded-3pb.toml", -1.0, "linear"),
     "fig4": ("paper-fig4-bonded-3pb.toml", -12.0, "nonlinear"),
@@ -56,7 +63,7 @@ CASES = {
 REFERENCE_LEVEL = {"bend": "fine", "c3": "medium", "demo": "fine"}
 FIELDS = ["case", "variant", "elements", "dofs", "levels", "estimate", "lambda_end", "reached",
           "steps", "iterations", "seconds", "load", "w_end", "max_steps", "faces", "membrane",
-          "contact"]
+          "contact", "measured"]
 PAPER_CHOICES = {"f": ("faces", "paper"), "m": ("membrane", "paper"), "s": ("contact", "same-x")}
 
 
@@ -112,7 +119,7 @@ def solve_reference(case: str) -> None:
     cached = json.loads(path.read_text()) if path.exists() else {}
     cached[case] = {"level": level, "lambda_end": sol.history[-1].load_factor,
                     "converged": sol.converged, "seconds": time.perf_counter() - t,
-                    "dofs": sol.dofs}
+                    "dofs": sol.dofs, "measured": measured_on()}
     path.write_text(json.dumps(cached, indent=2) + "\n")
     print(case, cached[case], flush=True)
 
@@ -126,6 +133,7 @@ def one(case: str, variant: str, elements: int | None, max_steps: int | None = N
         opts.update(core_level=int(core_part[1:]),
                     core_basis="polynomial" if core_part[0] == "P" else "sublayers")
     load = os.getloadavg()[0]
+    stamp = measured_on()
     t = time.perf_counter()
     r = run(scene, elements=elements, model_options=opts)
     seconds = time.perf_counter() - t
@@ -142,15 +150,18 @@ def one(case: str, variant: str, elements: int | None, max_steps: int | None = N
                 steps=len(s.history), iterations=s.extra["total_newton_iterations"],
                 seconds=f"{seconds:.2f}", load=f"{load:.2f}",
                 w_end=f"{s.history[-1].probes[scene.analysis.until_probe]:.4g}",
-                max_steps=scene.analysis.max_steps, **choice)
+                max_steps=scene.analysis.max_steps, **choice,
+                measured=machine_and_date(stamp))
 
 
-def report() -> None:
-    rows = list(csv.DictReader(open(OUT / "core_levels.csv")))
+def report(out: Path = OUT) -> None:
+    """Write ``core_levels.md`` and ``core_levels.png`` in ``out`` from its every row."""
+    rows = list(csv.DictReader(open(out / "core_levels.csv")))
     lines = ["# Beam core levels against the 2D reference (benchmarks/core_levels.py)", "",
              "err = λ_beam/λ_2D − 1 at the case's target deflection; `estimate` = the beam's own",
              "indicator (auto); seconds = whole beam solve in one process; load = 1-min load",
-             "average when the run started (the machine has 2 cores: > 2 means shared).", ""]
+             "average when the run started (the machine has 2 cores: > 2 means shared).", "",
+             measured_line(rows), ""]
     import matplotlib
 
     matplotlib.use("Agg")
@@ -193,8 +204,8 @@ def report() -> None:
         ax.set(title=case, xlabel="beam wall time (s)", ylabel="|λ/λ_2D − 1|")
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(OUT / "core_levels.png", dpi=110)
-    (OUT / "core_levels.md").write_text("\n".join(lines) + "\n")
+    fig.savefig(out / "core_levels.png", dpi=110)
+    (out / "core_levels.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 
@@ -206,24 +217,19 @@ def main() -> None:
     p.add_argument("--max-steps", type=int, default=None, help="cap the path's steps")
     p.add_argument("--reference2d", nargs="*", choices=sorted(CASES))
     p.add_argument("--report", action="store_true")
+    add_out_argument(p, OUT)
     a = p.parse_args()
-    OUT.mkdir(parents=True, exist_ok=True)
+    a.out.mkdir(parents=True, exist_ok=True)
     if a.reference2d:
         for case in a.reference2d:
             solve_reference(case)
         return
     if a.report:
-        report()
+        report(a.out)
         return
-    path = OUT / "core_levels.csv"
     for v in a.variants:
         row = one(a.case, v, a.elements, a.max_steps)
-        new = not path.exists()
-        with open(path, "a", newline="") as f:
-            w = csv.DictWriter(f, FIELDS)
-            if new:
-                w.writeheader()
-            w.writerow(row)
+        append_row(a.out / "core_levels.csv", FIELDS, row)
         print(row, flush=True)
 
 

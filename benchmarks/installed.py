@@ -14,8 +14,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-PACKAGES = ("beam_element", "comparisons", "meshes", "models", "reference2d", "sandwich",
-            "sandwich_cli", "studies")  # as scripts/setup.sh
+PACKAGES = ("sandwich",)  # as scripts/setup.sh
 
 
 def write_bytecode() -> None:

@@ -1,7 +1,8 @@
 """Beam against the 2D coarse model on every shipped scene: cost and end load, side by side.
 
-Run: ``.venv/bin/python benchmarks/scene_speed.py [--scenes NAME ...] [--timeout S]``. Writes
-``benchmarks/results/beam/scene_speed.{md,csv}``.
+Run from the project root: ``python -m benchmarks.scene_speed [--scenes NAME ...] [--timeout S]
+[--out DIR]``. Writes ``benchmarks/results/beam/scene_speed.{md,csv}`` (a rerun replaces them).
+The ``sandwich`` command is the one installed beside the interpreter that runs the script.
 
 Per scene of ``scenes/``, each in its own process as a user runs it, one after the other:
 
@@ -28,17 +29,18 @@ import csv
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import time
 import tomllib
 from pathlib import Path
 
-from installed import write_bytecode  # benchmarks/, the script's folder
+from benchmarks.installed import write_bytecode
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, console_script, measured_on
 
-ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"
-OUT = ROOT / "benchmarks" / "results" / "beam"
-SANDWICH = ROOT / ".venv" / "bin" / "sandwich"
+OUT = RESULTS / "beam"
+SANDWICH = console_script("sandwich")
 
 
 def load1() -> float:
@@ -85,10 +87,11 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--scenes", nargs="*", help="scene names (default: every file in scenes/)")
     p.add_argument("--timeout", type=float, default=900.0, help="seconds per run")
-    p.add_argument("--out", default="scene_speed", help="output stem under benchmarks/results/beam")
+    add_out_argument(p, OUT)
     args = p.parse_args()
     names = args.scenes or sorted(f.stem for f in SCENES.glob("*.toml"))
     write_bytecode()  # the runs start from the installed state (benchmarks/installed.py)
+    stamp = measured_on()
     rows = []
     for name in names:
         scene = SCENES / f"{name}.toml"
@@ -101,12 +104,12 @@ def main() -> None:
                 row[f"{key}_{field}"] = r.get(field)
         rows.append(row)
         print(name, {k: (r["status"], r.get("wall")) for k, r in runs.items()}, flush=True)
-    OUT.mkdir(parents=True, exist_ok=True)
-    with open(OUT / f"{args.out}.csv", "w", newline="") as fh:
+    args.out.mkdir(parents=True, exist_ok=True)
+    with open(args.out / "scene_speed.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    (OUT / f"{args.out}.md").write_text(markdown(rows))
+    (args.out / "scene_speed.md").write_text(markdown(rows, stamp))
 
 
 def _num(x, fmt: str) -> str:
@@ -121,22 +124,20 @@ def _kernel_backend() -> str:
     """Which kernels the beam runs used (sandwich/solver/jit.py), asked of a fresh process."""
     code = ("from sandwich.solver.jit import kernel_backend as k; b = k(); "
             "print(b['backend'], '-', b['reason'])")
-    p = subprocess.run([str(ROOT / ".venv" / "bin" / "python"), "-c", code], capture_output=True,
-                       text=True, cwd=ROOT)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     out = p.stdout.strip() or p.stderr.strip()[-200:]
     return ("the ahead-of-time build (" + out.split(" - ", 1)[-1] + ")"
             if out.startswith("aot") else f"numba's JIT ({out})")
 
 
-def markdown(rows: list[dict]) -> str:
+def markdown(rows: list[dict], stamp: str) -> str:
     """The table: per scene the three runs and the 2D-coarse-over-beam ratios."""
-    stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True, cwd=ROOT).stdout.strip()
     lines = [
         "# Beam vs 2D coarse on every shipped scene (`benchmarks/scene_speed.py`)",
         "",
-        f"Commit {commit}, {stamp}; each run its own `sandwich solve` process, one at a time, on "
+        f"{stamp} Commit {commit}; each run its own `sandwich solve` process, one at a time, on "
         "a 2-core machine (the largest 1-minute load average seen around each run is in the "
         "last column). solve = `summary.json` `wall_seconds`; whole = the process. "
         "Ratios: 2D coarse over beam (> 1: the beam is faster). The scene's `until` target ends "

@@ -2,23 +2,19 @@
 
 References: (1) synthetic G = a w² (beam) and b w² (2D) sampled on different steps, whose
 ratio a/b is known exactly (√G interpolation is exact there); (2) the peel couple of
-tests/fracture (closed form G(λ), derived there): each model's G at the end of the path must be
-its closed form at its own load factor, and the compare ratio must then be (λ_beam / λ_2D)²,
-numbers the models compute independently.
+benchmarks/cases/fracture_cases.py (closed form G(λ), derived there): each model's G at the end
+of the path must be its closed form at its own load factor, and the compare ratio must then be
+(λ_beam / λ_2D)², numbers the models compute independently.
 """
 
 import csv
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from sandwich.compare.releases import release_agreements, release_curve
 from sandwich.results import Solution, StepRecord
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fracture"))
 
 
 def _synthetic(model, a, ws, blank=()):
@@ -52,8 +48,7 @@ def test_no_common_tip_no_agreement():
 
 @pytest.mark.dolfinx
 def test_compare_overlays_g_of_both_models_on_the_peel_couple(tmp_path):
-    from fracture_cases import peel_g, peel_loads, scene
-
+    from benchmarks.cases.fracture_cases import peel_g, peel_loads, scene
     from sandwich.compare import compare
 
     sc = scene(peel_loads(), elements=240)

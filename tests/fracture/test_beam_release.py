@@ -9,7 +9,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from fracture_cases import (
+
+from benchmarks.cases.fracture_cases import (
     cantilever_slope,
     peel_g,
     peel_loads,
@@ -17,7 +18,6 @@ from fracture_cases import (
     shear_g,
     shear_loads,
 )
-
 from sandwich.beam.constraints import NodeSupport, build_dof_map
 from sandwich.beam.dofs import NODE_DOFS
 from sandwich.beam.fracture import beam_tips, column_names, tip_releases

@@ -3,8 +3,8 @@
 import dataclasses
 
 import pytest
-from fracture_cases import peel_g, peel_loads, scene
 
+from benchmarks.cases.fracture_cases import peel_g, peel_loads, scene
 from sandwich.beam.solve import run
 from sandwich.fracture import bk_toughness, growth_onset
 from sandwich.results import StepRecord

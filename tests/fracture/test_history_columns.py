@@ -10,8 +10,8 @@ import csv
 import json
 
 import pytest
-from fracture_cases import peel_g, peel_loads, scene
 
+from benchmarks.cases.fracture_cases import peel_g, peel_loads, scene
 from sandwich.fracture import growth_onset, missing_releases
 from sandwich.models import run_model
 from sandwich.results import Solution, StepRecord, load_result, write_solution

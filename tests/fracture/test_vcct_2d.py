@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fracture_cases import (
+
+from benchmarks.cases.fracture_cases import (
     cantilever_slope,
     peel_g,
     peel_loads,

@@ -1,0 +1,1 @@
+"""Scenes with known answers shared by the benchmarks and the tests (closed-form fracture cases)."""
