@@ -1,15 +1,16 @@
 """Sum factorisation of the core levels: one Newton iteration before/after, side by side.
 
-Run: ``.venv/bin/python benchmarks/beam_sum_factor.py [--quick] [--path SCENE ...]``. Writes
-``benchmarks/results/beam/sum_factor.{md,csv}``: per element count (60 … 1920) and core level
-(1-4, sublayers), at the nonlinear state of ``beam_speed.py`` (fig. 5 scene, linear solution
-scaled to 5 mm at mid-span, contact active), the model's force + tangent with the packed kernel
+Run from the project root: ``python -m benchmarks.beam_sum_factor [--quick] [--path SCENE ...]
+[--out DIR]``. Writes ``benchmarks/results/beam/sum_factor.{md,csv}`` (a rerun replaces them):
+per element count (60 … 1920) and core level (1-4, sublayers), at the nonlinear state of
+``benchmarks.beam_speed`` (fig. 5 scene, linear solution scaled to 5 mm at mid-span, contact
+active), the model's force + tangent with the packed kernel
 (``kernels.SUM_FACTORISATION = "never"``, what main had) and with the default (``"auto"``: the
 sum-factorised kernel on enriched cores), measured alternately in the same process (best of 3,
 wall and thread CPU time), the factorisation and the corrector's two solves (the same for both),
 and the flops as executed (:func:`sandwich.beam.kernels.layer_flops`). With ``--path``: the whole
 path of each scene at its own settings (``core = "auto"`` by default), both ways, in process
-(``summary`` wall seconds).
+(``summary`` wall seconds), into ``sum_factor_paths.md``.
 
 The machine is shared (2 cores, other jobs): every row records ``uptime``'s load; the CPU-time
 column is the less load-sensitive one.
@@ -18,22 +19,18 @@ column is the less load-sensitive one.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.beam_speed import SCENE, deformed_state, dgemm_rate, load
+from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from sandwich.beam import build_model, kernels, run
+from sandwich.scene_file import load_scene
+from sandwich.solver.envelope import EnvelopeFactorization
 
-from beam_speed import SCENE, deformed_state, dgemm_rate, load  # noqa: E402
-
-from sandwich.beam import build_model, kernels, run  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
-from sandwich.solver.envelope import EnvelopeFactorization  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 MODES = ("never", "auto")  # before (packed kernel everywhere), after (the default)
 
 
@@ -120,10 +117,10 @@ def path_rows(scenes):
     return out
 
 
-def write(rows, peak):
-    OUT.mkdir(parents=True, exist_ok=True)
+def write(rows, peak, out=OUT, stamp=""):
+    out.mkdir(parents=True, exist_ok=True)
     keys = [k for k in rows[0] if not k.startswith("load")]
-    (OUT / "sum_factor.csv").write_text(",".join(keys) + "\n" + "".join(
+    (out / "sum_factor.csv").write_text(",".join(keys) + "\n" + "".join(
         ",".join(f"{r[k]:.6g}" if isinstance(r[k], float) else str(r[k]) for k in keys) + "\n"
         for r in rows))
     md = [
@@ -138,6 +135,8 @@ def write(rows, peak):
         "solves (the same matrix both ways). Flops as executed: the kernels' GEMMs and "
         "contractions (strains, stresses, scatter not counted), factorisation, solves. "
         f"DGEMM rate measured in the same run: {peak / 1e9:.1f} GF/s.",
+        "",
+        stamp,
         "",
         f"**Shared machine, 2 cores: {rows[0]['load_before']} at the start, "
         f"{rows[-1]['load_after']} at the end.** Wall times are inflated by the other jobs; "
@@ -162,7 +161,7 @@ def write(rows, peak):
             f"{r['auto_mflop']:.1f} | {r['factorize_s'] * 1e3:.2f} | "
             f"{r['two_solves_s'] * 1e3:.2f} | {it_b * 1e3:.2f} | {it_a * 1e3:.2f} | "
             f"{it_b / it_a:.2f} | {fl / 1e3 / it_a:.1f} | {r['tangent_rel_diff']:.1e} |")
-    (OUT / "sum_factor.md").write_text("\n".join(md) + "\n")
+    (out / "sum_factor.md").write_text("\n".join(md) + "\n")
 
 
 def main():
@@ -170,30 +169,34 @@ def main():
     p.add_argument("--quick", action="store_true", help="60 and 240 elements only")
     p.add_argument("--path", nargs="*", default=[], help="scenes to run whole paths of")
     p.add_argument("--no-iterations", action="store_true", help="only the paths")
+    add_out_argument(p, OUT)
     args = p.parse_args()
+    stamp = measured_on()
     counts = [60, 240] if args.quick else [60 * 2**k for k in range(6)]  # 60 … 1920
     cases = [(n, level) for level in (1, 2, 3, 4) for n in counts]
     peak = dgemm_rate()
     if not args.no_iterations:
-        write(iteration_rows(cases, repeat=3), peak)
+        write(iteration_rows(cases, repeat=3), peak, args.out, stamp)
     if args.path:
-        write_paths(path_rows(args.path))
+        stamp = measured_on()
+        write_paths(path_rows(args.path), args.out, stamp)
 
 
-def write_paths(paths):
+def write_paths(paths, out=OUT, stamp=""):
     """The whole-path table, ``sum_factor_paths.md``."""
     md = ["Whole paths in process (`sandwich.beam.run`, each scene's own settings: `core = "
           "\"auto\"` unless the scene says otherwise), before (packed kernel everywhere, "
           "`never`) and after (`auto`), one run each, in this order. Solve wall = "
           "`summary.json` `wall_seconds`. Shared 2-core machine: the load is given per run.", "",
+          stamp, "",
           "| scene | kernel | solve wall (s) | in process (s) | steps | Newton its | final λ | "
           "load before | load after |", "|---|---|---:|---:|---:|---:|---:|---|---|"]
     for p in paths:
         md.append(f"| {p['scene']} | {p['mode']} | {p['wall_s']:.2f} | {p['in_process_s']:.2f} | "
                   f"{p['steps']} | {p['iterations']} | {p['final_load_factor']:.12g} | "
                   f"{p['load_before']} | {p['load_after']} |")
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "sum_factor_paths.md").write_text("\n".join(md) + "\n")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "sum_factor_paths.md").write_text("\n".join(md) + "\n")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Beam G against closed form for uniform core levels and for level patches at the tip.
 
 Why does the beam's G move with the core level (docs/fracture.md "Beam core levels")? For the
-closed-form cases of ``tests/fracture/fracture_cases.py`` (peel couple, sliding couples,
+closed-form cases of ``benchmarks/cases/fracture_cases.py`` (peel couple, sliding couples,
 cantilever face slope), geometrically linear (λ = 1, one linear solve), this measures
 
 - the history columns' estimate (:func:`sandwich.beam.fracture.tip_releases`: closure over
@@ -13,8 +13,8 @@ cantilever face slope), geometrically linear (λ = 1, one linear solve), this me
 
 for uniform core levels 1…6 (``--levels``) and meshes, and for a level-k patch of p elements on
 each side of the tip on a level-1 beam (what "auto" does). Writes
-``benchmarks/results/fracture/core_levels.md`` (+ ``.csv``). Run:
-``.venv/bin/python benchmarks/fracture_core_levels.py``.
+``benchmarks/results/fracture/core_levels.md`` (+ ``.csv``; a rerun replaces them). Run from the
+project root: ``python -m benchmarks.fracture_core_levels [--out DIR]``.
 """
 
 from __future__ import annotations
@@ -23,16 +23,11 @@ import argparse
 import csv
 import dataclasses
 import os
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fracture"))
-
-from fracture_cases import (  # noqa: E402
+from benchmarks.cases.fracture_cases import (
     cantilever_slope,
     peel_g,
     peel_loads,
@@ -40,13 +35,13 @@ from fracture_cases import (  # noqa: E402
     shear_g,
     shear_loads,
 )
+from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from sandwich.beam.constraints import NodeSupport, build_dof_map
+from sandwich.beam.fracture import beam_tips, closure_release, tip_releases
+from sandwich.beam.model import build_model
+from sandwich.beam.solve import linear_solution
 
-from sandwich.beam.constraints import NodeSupport, build_dof_map  # noqa: E402
-from sandwich.beam.fracture import beam_tips, closure_release, tip_releases  # noqa: E402
-from sandwich.beam.model import build_model  # noqa: E402
-from sandwich.beam.solve import linear_solution  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "fracture"
+OUT = RESULTS / "fracture"
 CLOSURES = (1, 2, 4, 8)
 
 
@@ -135,10 +130,11 @@ def run(args):
     return rows
 
 
-def write(rows, stem):
-    OUT.mkdir(parents=True, exist_ok=True)
+def write(rows, out=OUT, stamp=""):
+    stem = "core_levels"
+    out.mkdir(parents=True, exist_ok=True)
     keys = list(rows[0])
-    with open(OUT / f"{stem}.csv", "w", newline="") as fh:
+    with open(out / f"{stem}.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, keys)
         w.writeheader()
         w.writerows(rows)
@@ -151,7 +147,7 @@ def write(rows, stem):
              "one-element VCCT of the G columns until 2026-12-01); "
              "extension = energy of untying the tip node at fixed load (the discrete model's "
              "own G over one element). Cantilever: slope d√G/da / closed form. G_II/G of the "
-             "history estimate (at a = 60 for the cantilever).", "",
+             "history estimate (at a = 60 for the cantilever).", "", stamp, "",
              "| case | config | el. | history (Δ≈t) | " + " | ".join(f"Δ={n}" for n in CLOSURES)
              + " | extension | G_II/G |",
              "|---" * (6 + len(CLOSURES)) + "|"]
@@ -159,7 +155,7 @@ def write(rows, stem):
         lines.append(f"| {r['case']} | {r['config']} | {r['elements']} | {r['history']:.4f} | "
                      + " | ".join(f"{r[f'closure_{n}']:.4f}" for n in CLOSURES)
                      + f" | {r['extension']:.4f} | {r['GII_over_G']:.3f} |")
-    (OUT / f"{stem}.md").write_text("\n".join(lines) + "\n")
+    (out / f"{stem}.md").write_text("\n".join(lines) + "\n")
 
 
 def main():
@@ -168,9 +164,10 @@ def main():
         "uniform:1", "uniform:2", "uniform:3", "uniform:4", "uniform:6",
         "patch:2:2", "patch:2:5", "patch:2:16", "patch:2:64", "patch:4:5", "patch:4:64"])
     ap.add_argument("--elements", nargs="+", type=int, default=[480])
-    ap.add_argument("--stem", default="core_levels")
+    add_out_argument(ap, OUT)
     args = ap.parse_args()
-    write(run(args), args.stem)
+    stamp = measured_on()
+    write(run(args), args.out, stamp)
 
 
 if __name__ == "__main__":

@@ -1,11 +1,6 @@
-"""Thin script over :mod:`benchmarks.sweeps.tradeoff` (``--help``)."""
+"""Thin script over :mod:`benchmarks.sweeps.tradeoff`: ``python -m benchmarks.tradeoff --help``."""
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout, not installed
-
-from benchmarks.sweeps.tradeoff import main  # noqa: E402
+from benchmarks.sweeps.tradeoff import main
 
 if __name__ == "__main__":
     raise SystemExit(main())

@@ -20,11 +20,12 @@ curves, beam against 2D, as functions of |until probe| (:mod:`sandwich.compare.p
 - ``end_error``: (λ_beam − λ_2D) / |λ_2D| at the end of the common range.
 
 Writes ``extremes.csv``, ``extremes.md`` and ``extremes.png`` into
-``benchmarks/results/comparisons/`` after every sweep (the cases themselves are kept in the
-studies' folders: an interrupted map resumes with every finished case reused).
+``benchmarks/results/comparisons/`` (or ``--out DIR``) after every sweep, each row with the
+machine and date it was measured on (the cases themselves are kept in the studies' folders: an
+interrupted map resumes with every finished case reused).
 
-Usage: ``python benchmarks/extremes.py [--sweeps stiffness ...] [--workers N] [--scheduler
-ADDRESS] [--studies DIR] [--out DIR] [--render]``
+Usage, from the project root: ``python -m benchmarks.extremes [--sweeps stiffness ...] [--workers
+N] [--scheduler ADDRESS] [--studies DIR] [--out DIR] [--render]``
 """
 
 from __future__ import annotations
@@ -44,6 +45,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from benchmarks.provenance import (  # noqa: E402
+    RESULTS,
+    ROOT,
+    add_out_argument,
+    machine_and_date,
+    measured_line,
+    measured_on,
+)
 from sandwich.compare.paths import LOAD, curve_error, path_curve, path_parameter  # noqa: E402
 from sandwich.results import Solution, load_result  # noqa: E402
 from sandwich.scene import Debond, Layer, Load, Probe, Scene, Support  # noqa: E402
@@ -51,8 +60,7 @@ from sandwich.studies.study import run_study  # noqa: E402
 from sandwich.studies.study_file import Study, load_study  # noqa: E402
 from sandwich.studies.study_run import case_folder  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]  # the project: scenes/, benchmarks/results/
-OUT = ROOT / "benchmarks" / "results" / "comparisons"
+OUT = RESULTS / "comparisons"
 BASE = "paper-fig5-top-debond-40-load-top"
 STUDIES = ROOT / "studies" / "shipped"  # extremes-<sweep>.toml
 STUDY_OUT = ROOT / "results" / "studies"  # the studies' own folders (cases, tables)
@@ -302,7 +310,8 @@ def write(rows: list[dict[str, object]], out: Path, header: list[str] | None = N
         w.writeheader()
         w.writerows({k: ("" if r.get(k) is None else r.get(k)) for k in keys} for r in rows)
     check = any(f"{CHECK}_status" in r for r in rows)
-    md = ["# Stability at the extremes (benchmarks/extremes.py)", "", *(header or []),
+    md = ["# Stability at the extremes (benchmarks/extremes.py)", "", measured_line(rows), "",
+          *(header or []),
           f"Base scene: {BASE}. Status: ✓ reached the target; ✗ N % stopped before it (N = "
           "|until probe| reached / target); ✓✗ N % passed the target but could not hit it "
           "within the solver's target_tol (a converged path past the target); ✗! the solve "
@@ -437,13 +446,14 @@ def map_rows(sweep: str, study: Study, result, out: Path) -> list[dict[str, obje
         r = row(sweep, value, case.scene, {"beam": beam, "2d": ref})
         r.update(elements=case.scene.beam_model.elements, level=case.scene.reference2d.level,
                  cap_s=study.timeout, max_cells=study.max_cells, case=case.index,
-                 finished=time.strftime("%Y-%m-%d %H:%M:%S"))
+                 finished=time.strftime("%Y-%m-%d %H:%M:%S"),
+                 measured=machine_and_date(measured_on()))
         rows.append(r)
     return rows
 
 
 def main(argv: list[str] | None = None) -> int:
-    """The map's command line (``python benchmarks/extremes.py --help``)."""
+    """The map's command line (``python -m benchmarks.extremes --help``)."""
     ap = argparse.ArgumentParser(description="stability map of both models, from the five "
                                              "extremes studies")
     ap.add_argument("--sweeps", nargs="+", default=list(SWEEPS), choices=list(SWEEPS))
@@ -455,7 +465,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="only redraw extremes.md/.png from extremes.csv in --out")
     ap.add_argument("--note", action="append", default=[],
                     help="a line for the map's header (e.g. the machine and its load)")
-    ap.add_argument("--out", type=Path, default=OUT)
+    add_out_argument(ap, OUT)
     args = ap.parse_args(argv)
     if args.render:
         rows = [_parse(r) for r in csv.DictReader((args.out / "extremes.csv").open())]

@@ -11,7 +11,8 @@ every resolution; wall times are measured here. The error of every run is taken 
 - headline: for each model the cheapest run with error ≤ 1 %, and the 2D / beam time ratio.
 
 Writes ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` (error vs time, Pareto fronts)
-into ``benchmarks/results/comparisons/``.
+into ``benchmarks/results/comparisons/`` (a rerun replaces them; ``--out DIR`` for another
+folder); the table says the machine and date it was measured on.
 
 Beam variants: ``paper`` (the paper's element: core level 1, ``faces = "paper"``,
 ``face_membrane = "paper"``, ``contact_search = "same-x"``), ``averaged`` (the same with
@@ -24,9 +25,9 @@ its path is compared to −12 mm). Wall and CPU seconds are both recorded: on a 
 the CPU time is the steadier of the two. Before the sweep each model solves the first scene once,
 untimed (:func:`warm_up`): the process's first 2D solve pays the imports of dolfinx and PETSc.
 
-Usage: ``python benchmarks/tradeoff.py [--elements 15 30 60 120] [--levels coarse medium fine]
-[--refine 0 1] [--scenes paper-fig4-bonded-3pb ...] [--variants paper averaged]
-[--until paper-fig4-bonded-3pb=-12]``
+Usage, from the project root: ``python -m benchmarks.tradeoff [--elements 15 30 60 120]
+[--levels coarse medium fine] [--refine 0 1] [--scenes paper-fig4-bonded-3pb ...] [--variants
+paper averaged] [--until paper-fig4-bonded-3pb=-12] [--out DIR]``
 """
 
 from __future__ import annotations
@@ -46,13 +47,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on  # noqa: E402
 from sandwich.models import MODELS, with_options  # noqa: E402
 from sandwich.results import Solution  # noqa: E402
 from sandwich.scene import BeamModelOptions, Scene  # noqa: E402
 from sandwich.scene_file import load_scene  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]  # the project: scenes/, benchmarks/results/
-OUT = ROOT / "benchmarks" / "results" / "comparisons"
+OUT = RESULTS / "comparisons"
 SCENES = ("paper-fig4-bonded-3pb", "paper-fig5-top-debond-40-load-top")
 TARGET = 0.01  # the headline error level
 
@@ -170,8 +171,11 @@ def headline(runs: list[Run], scene: str) -> str:
             f"2D/beam time ratio {t.seconds / b.seconds:.3g}")
 
 
-def write(runs: list[Run], lines: list[str], out: Path) -> None:
-    """Write ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` into ``out``."""
+def write(runs: list[Run], lines: list[str], out: Path, stamp: str = "") -> None:
+    """Write ``tradeoff.csv``, ``tradeoff.md`` and ``tradeoff.png`` into ``out``.
+
+    ``stamp`` is the table's :func:`~benchmarks.provenance.measured_on` line.
+    """
     out.mkdir(parents=True, exist_ok=True)
     with (out / "tradeoff.csv").open("w", newline="") as fh:
         w = csv.writer(fh, lineterminator="\n")
@@ -187,7 +191,7 @@ def write(runs: list[Run], lines: list[str], out: Path) -> None:
           "Error: load at the end of the path (the mid-span probe at its target) against the "
           "finest 2D run; time measured in the same process, after one untimed solve with "
           "each model (the process's lazy imports and cold caches are not a resolution's "
-          "cost).", ""]
+          "cost).", "", *([stamp, ""] if stamp else [])]
     md += [f"- {line}" for line in lines] + ["",
            "| scene | model | resolution | wall (s) | CPU (s) | DOFs | converged | error |",
            "|---|---|---|---|---|---|---|---|"]
@@ -235,7 +239,7 @@ def warm_up(name: str, level: str, variant: str, elements: list[int], until: dic
 
 
 def main(argv: list[str] | None = None) -> int:
-    """The benchmark's command line (``python benchmarks/tradeoff.py --help``)."""
+    """The benchmark's command line (``python -m benchmarks.tradeoff --help``)."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenes", nargs="+", default=list(SCENES))
     ap.add_argument("--elements", nargs="+", type=int, default=[15, 30, 60, 120, 240])
@@ -249,8 +253,9 @@ def main(argv: list[str] | None = None) -> int:
                     metavar="SCENE=VALUE", help="end a scene's path at this probe value")
     ap.add_argument("--scene-levels", nargs="+", default=[], metavar="SCENE=LEVEL,LEVEL",
                     help="2D levels of one scene (default: --levels)")
-    ap.add_argument("--out", type=Path, default=OUT)
+    add_out_argument(ap, OUT)
     args = ap.parse_args(argv)
+    stamp = measured_on()
     per_variant = {}
     for item in args.variant_elements:
         name, _, counts = item.partition("=")
@@ -295,7 +300,7 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(headline(rs, name) + f" [path to {scene.analysis.until_probe} = "
                      f"{scene.analysis.until_value:g}; load average {load:.2f} at start, "
                      f"{os.getloadavg()[0]:.2f} at end, {platform.node()}]")
-        write(runs, lines, args.out)  # after each scene: a partial table survives a crash
+        write(runs, lines, args.out, stamp)  # after each scene: a partial table survives a crash
     print("\n".join(lines))
     return 0
 
