@@ -8,25 +8,21 @@ The bottom face measures the global response (bending, shear, supports); the ind
 core's local response, which the paper's core (cubic in z over its whole height) can only
 approximate once the load is narrow compared with the core thickness (25 mm).
 
-Run: ``XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/beam_vs_2d_indentation.py
-[--elements 480] [--levels coarse medium]``. Writes
-``benchmarks/results/comparisons/indentation.md``.
+Run from the project root: ``python -m benchmarks.beam_vs_2d_indentation [--elements 480]
+[--levels coarse medium] [--out DIR]``. Writes ``benchmarks/results/comparisons/indentation.md``
+(a rerun replaces it).
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import sys
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.scene import Scene
+from sandwich.scene_file import load_scene
 
-from sandwich.scene import Scene  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "comparisons"
+OUT = RESULTS / "comparisons"
 WIDTHS = (300.0, 40.0, 20.0, 10.0, 5.0, 2.5)
 LOAD = 100.0
 
@@ -48,7 +44,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--elements", type=int, default=480)
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium"])
+    add_out_argument(ap, OUT)
     args = ap.parse_args(argv)
+    stamp = measured_on()
     import sandwich.beam
     import sandwich.plane2d
 
@@ -56,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
           f"benchmarks/beam_vs_2d_indentation.py; beam {args.elements} graded elements "
           "(averaged face membrane: the converged element, linear answers equal the paper's); "
           f"2D levels {', '.join(args.levels)} (ratios against the last). Indentation = "
-          "w_top_mid − w_bottom_mid.", "",
+          "w_top_mid − w_bottom_mid.", "", stamp, "",
           "| patch width (mm) | beam w_top | beam w_bot | beam indent. | "
           + " | ".join(f"2D {lv} indent." for lv in args.levels)
           + " | 2D w_bot | ratio w_bot | ratio indent. |",
@@ -71,8 +69,8 @@ def main(argv: list[str] | None = None) -> int:
                   + " | ".join(f"{t - b:.5f}" for t, b in ref)
                   + f" | {rb:.5f} | {bb / rb:.4f} | {(bt - bb) / (rt - rb):.4f} |")
         print(md[-1], flush=True)
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "indentation.md").write_text("\n".join(md) + "\n")
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "indentation.md").write_text("\n".join(md) + "\n")
     return 0
 
 

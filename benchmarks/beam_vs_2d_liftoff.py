@@ -17,8 +17,9 @@ Two experiments for docs/beam_vs_2d.md §3 (both models, profiles at every step)
 Clamped Euler estimate of the debonded face: P_E = 4 π² E b t³ / (12 a²) with a = 40 mm;
 face force N ≈ M / d (sandwich theory, d = t + h_c), M = λ · 100 N·mm between the loads.
 
-Run: ``XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/beam_vs_2d_liftoff.py [fig5|bending]
-[--elements 240] [--level coarse]``. Writes ``benchmarks/results/comparisons/liftoff_<case>.md``.
+Run from the project root: ``python -m benchmarks.beam_vs_2d_liftoff [fig5|bending] [--elements
+240] [--level coarse] [--out DIR]``. Writes ``benchmarks/results/comparisons/liftoff_<case>.md``
+(a rerun replaces it).
 """
 
 from __future__ import annotations
@@ -26,20 +27,16 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.results import Solution
+from sandwich.scene import Load, Scene
+from sandwich.scene_file import load_scene
 
-from sandwich.results import Solution  # noqa: E402
-from sandwich.scene import Load, Scene  # noqa: E402
-from sandwich.scene_file import load_scene  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "comparisons"
+OUT = RESULTS / "comparisons"
 OPEN_P = 1e-5  # MPa: a station with less contact pressure than this is contact-free
 STEP = 0.1  # mm: largest displacement increment of the fig5 case
 
@@ -100,7 +97,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("case", choices=["fig5", "bending"], nargs="?", default="fig5")
     ap.add_argument("--elements", type=int, default=240)
     ap.add_argument("--level", default="coarse")
+    add_out_argument(ap, OUT)
     args = ap.parse_args(argv)
+    stamp = measured_on()
     import sandwich.beam
     import sandwich.plane2d
 
@@ -114,7 +113,7 @@ def main(argv: list[str] | None = None) -> int:
     md = [f"# Lift-off of the debonded top face: {s.name}", "",
           f"benchmarks/beam_vs_2d_liftoff.py {args.case}; beam {args.elements} graded elements, "
           f"2D level {args.level}. Contact-free: contact pressure < {OPEN_P:g} MPa at a profile "
-          "station inside the debond.", ""]
+          "station inside the debond.", "", stamp, ""]
     if args.case == "bending":
         md += [f"Clamped Euler load of the 40 mm face reached at λ_E ≈ "
                f"{euler_load_factor(s):.1f} (M/d = P_E).", ""]
@@ -135,9 +134,9 @@ def main(argv: list[str] | None = None) -> int:
         md += [f"| {lam:.1f} | {ln:.2f} | {pm:.3g} | {ind:.4f} |" for lam, ln, pm, ind in rows]
         md.append("")
         print(f"{label}: {lps}", flush=True)
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / f"liftoff_{args.case}.md").write_text("\n".join(md))
-    print(f"wrote {OUT / f'liftoff_{args.case}.md'}")
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / f"liftoff_{args.case}.md").write_text("\n".join(md))
+    print(f"wrote {args.out / f'liftoff_{args.case}.md'}")
     return 0
 
 

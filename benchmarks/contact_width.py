@@ -1,7 +1,8 @@
 """What the contact law's regularisation width costs and changes: the beam's paths at × 1 and wider.
 
-Run: ``.venv/bin/python benchmarks/contact_width.py [--scenes NAME ...] [--levels 1 auto]
-[--factors 1 10]``. Writes ``benchmarks/results/beam/contact_width.{md,csv}``.
+Run from the project root: ``python -m benchmarks.contact_width [--scenes NAME ...] [--levels 1
+auto] [--factors 1 10] [--out DIR]``. Writes ``benchmarks/results/beam/contact_width.{md,csv}``
+(a rerun replaces them).
 
 The penalty law of a debonded interface (``sandwich.beam.contact.pressure_law``) is regularised
 over a width s (default ``sandwich.beam.model.default_contact_smoothing``,
@@ -21,14 +22,13 @@ import argparse
 import csv
 import os
 import time
-from pathlib import Path
 
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
 from sandwich.beam import run
 from sandwich.beam.model import BeamModel, default_contact_smoothing
 from sandwich.scene_file import load_scene
 
-ROOT = Path(__file__).resolve().parent.parent
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 DEFAULT_SCENES = tuple(p.stem for p in sorted((ROOT / "scenes").glob("*.toml")))
 COLUMNS = ["scene", "core", "factor", "width_mm", "wall_s", "steps", "iterations",
            "factorisations", "penalty_reruns", "reached", "end_load", "change"]
@@ -66,7 +66,9 @@ def main() -> None:
     parser.add_argument("--scenes", nargs="*", default=list(DEFAULT_SCENES))
     parser.add_argument("--levels", nargs="*", default=["1", "auto"])
     parser.add_argument("--factors", nargs="*", type=float, default=[1.0, 10.0])
+    add_out_argument(parser, OUT)
     args = parser.parse_args()
+    stamp = measured_on()
     if 1.0 not in args.factors:
         parser.error("--factors must include 1 (the shipped width, the reference)")
     start = os.getloadavg()
@@ -89,8 +91,8 @@ def main() -> None:
                 print(f"{name} core {level} ×{factor:g}: {row['wall_s']:.2f} s, "
                       f"{row['iterations']} its, λ {row['end_load']:.10g}", flush=True)
     end = os.getloadavg()
-    OUT.mkdir(parents=True, exist_ok=True)
-    with (OUT / "contact_width.csv").open("w", newline="") as fh:
+    args.out.mkdir(parents=True, exist_ok=True)
+    with (args.out / "contact_width.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, COLUMNS, lineterminator="\n")
         w.writeheader()
         for r in rows:
@@ -102,6 +104,7 @@ def main() -> None:
           "change of the end load against × 1. A modelling choice, measured: nothing in the "
           "code changes.",
           "",
+          stamp, "",
           f"Load average {start[0]:.2f} at the start, {end[0]:.2f} at the end (2 cores).", "",
           "| scene | core | width × | s (mm) | wall (s) | steps | Newton its | factorisations "
           "| penalty reruns | reached | end λ | change |",
@@ -112,7 +115,7 @@ def main() -> None:
                   f"{r['wall_s']:.2f} | {r['steps']} | {r['iterations']} | "
                   f"{r['factorisations']} | {r['penalty_reruns']} | {r['reached']} | "
                   f"{r['end_load']:.8g} | {change} |")
-    (OUT / "contact_width.md").write_text("\n".join(md) + "\n")
+    (args.out / "contact_width.md").write_text("\n".join(md) + "\n")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """A/B of the corrector's rising-residual test on every shipped scene (beam model).
 
-Run: ``.venv/bin/python benchmarks/corrector_rules.py [--scenes NAME ...] [--levels auto 1]``.
-Writes ``benchmarks/results/beam/corrector_rules.{md,csv}``.
+Run from the project root: ``python -m benchmarks.corrector_rules [--scenes NAME ...] [--levels
+auto 1] [--out DIR]``. Writes ``benchmarks/results/beam/corrector_rules.{md,csv}`` (a rerun
+replaces them).
 
 Each scene is solved in this process (kernels warm) with the path follower as shipped
 (``sandwich.solver.path.DIVERGENCE_RISES = 2``: a step's corrector whose residual rose twice in
@@ -18,15 +19,13 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import time
-from pathlib import Path
 
 import sandwich.solver.path as path_module
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
 from sandwich.beam import run
 from sandwich.scene_file import load_scene
 
-ROOT = Path(__file__).resolve().parent.parent
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 
 
 def solve(scene: object, level: str, rises: int) -> tuple[object, dict[str, int]]:
@@ -57,7 +56,9 @@ def main() -> None:
     parser.add_argument("--scenes", nargs="*",
                         default=sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")))
     parser.add_argument("--levels", nargs="*", default=["auto", "1"])
+    add_out_argument(parser, OUT)
     args = parser.parse_args()
+    stamp = measured_on()
     rows = []
     loads = [os.getloadavg()[0]]
     for name in args.scenes:
@@ -71,17 +72,17 @@ def main() -> None:
                              "converged": bool(sol.converged), **c})
                 loads.append(os.getloadavg()[0])
                 print(" ".join(f"{k}={v}" for k, v in rows[-1].items()), flush=True)
-    OUT.mkdir(parents=True, exist_ok=True)
-    with open(OUT / "corrector_rules.csv", "w", newline="") as fh:
+    args.out.mkdir(parents=True, exist_ok=True)
+    with open(args.out / "corrector_rules.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
     lines = [
         "# The corrector's rising-residual test, on and off (`benchmarks/corrector_rules.py`)",
         "",
-        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, "
-        f"1-minute load {min(loads):.2f}-{max(loads):.2f} over the runs (this benchmark's own "
-        "process included). Beam model, each scene in one process, off then on. `off`: "
+        f"{stamp} {os.cpu_count()} cores, 1-minute load {min(loads):.2f}-{max(loads):.2f} "
+        "over the runs (this benchmark's own process included). Beam model, each scene in one "
+        "process, off then on. `off`: "
         "`DIVERGENCE_RISES = 0` (the path follower before the test); `on`: 2 (as shipped). "
         "Corrector iterations: every corrector the path follower ran (steps, retries, target "
         "hits; the end-state checks of `auto` are not counted); failed: those that did not "
@@ -109,7 +110,7 @@ def main() -> None:
               f"({tot[2] / tot[0]:.2f}). An end load in bold: the two runs ended on different "
               "equilibria at the scene's until target (the branch-sensitive scenes, "
               "`benchmarks/results/comparisons/gallery_agreement.md`)."]
-    (OUT / "corrector_rules.md").write_text("\n".join(lines) + "\n")
+    (args.out / "corrector_rules.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

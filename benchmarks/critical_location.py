@@ -1,9 +1,10 @@
 """Bifurcation loads located within their step, against fine-step paths (sandwich.solver.critical).
 
-``python benchmarks/critical_location.py`` writes ``benchmarks/results/beam/critical_location.md``
-and ``.csv``. The knock-down study's model (fig. 5 scene, core level 1, 240 graded elements,
-the scene's other defaults) with a top debond centred under the load (x = 150 mm), lengths
-``--lengths``: each path followed three ways, and its first bifurcation read off three ways.
+``python -m benchmarks.critical_location [--out DIR]`` (from the project root) writes
+``benchmarks/results/beam/critical_location.md`` and ``.csv`` (a rerun replaces them). The
+knock-down study's model (fig. 5 scene, core level 1, 240 graded elements, the scene's other
+defaults) with a top debond centred under the load (x = 150 mm), lengths ``--lengths``: each
+path followed three ways, and its first bifurcation read off three ways.
 
 - paths: as shipped (arc-length, settling allowance 2); the same with the settling allowance
   off (shorter steps); displacement control of ``w_top_mid`` in steps of at most
@@ -24,19 +25,14 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))  # run from a checkout, not installed
-
-from location_table import reading_row, write_tables  # noqa: E402
-
-from sandwich.scene_file import load_scene  # noqa: E402
+from benchmarks.location_table import reading_row, write_tables
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.scene_file import load_scene
 
 SCENE = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 
 
 def case(length: float, how: str, fine: float, narrowed: bool):
@@ -78,9 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--lengths", type=float, nargs="+",
                    default=[20, 35, 40, 50, 55, 60, 70, 75])
     p.add_argument("--fine", type=float, default=0.05, help="fine path's step cap (mm)")
-    p.add_argument("--out", type=Path, default=OUT)
+    add_out_argument(p, OUT)
     args = p.parse_args(argv)
-    load0 = os.getloadavg()
+    load0, stamp = os.getloadavg(), measured_on()
     rows = []
     for length in args.lengths:
         ref = first_bifurcation(case(length, "fine", args.fine, True))
@@ -92,7 +88,8 @@ def main(argv: list[str] | None = None) -> int:
     write_tables(rows, args.out, "critical_location",
                  "First bifurcation loads located within their step "
                  "(benchmarks/critical_location.py)", __doc__.split("\n\n", 1)[1].strip(),
-                 ("debond (mm)", "---:", lambda r: f"{r['length_mm']:g}"), args.fine, load0)
+                 ("debond (mm)", "---:", lambda r: f"{r['length_mm']:g}"), args.fine, load0,
+                 stamp=stamp)
     return 0
 
 

@@ -6,12 +6,13 @@ scene's until-probe (interpolation of √G in each model's path, within the rang
 the plot overlays G, G_I and G_II against that probe. The 2D model also reports the domain
 J-integral (``sandwich.plane2d.jintegral``, disc of 4 face thicknesses) as a cross-check of its G.
 
-Run: ``XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/fracture_paths.py [--level medium]
-[--scenes fig5 c2 c3] [--reuse-2d] [--core 1]``. Writes
-``benchmarks/results/fracture/<scene>_<level>[_core<k>].md``, ``.csv`` and ``.png``.
-``--reuse-2d`` reads the 2D rows (G, split, J per converged step) from the stored
-``<scene>_<level>.csv`` instead of solving the 2D model again (hours on this machine at
-medium); ``--core`` sets the beam's ``[beam_model] core`` (default: the scene's).
+Run from the project root: ``python -m benchmarks.fracture_paths [--level medium] [--scenes fig5
+c2 c3] [--reuse-2d] [--core 1] [--out DIR]``. Writes
+``benchmarks/results/fracture/<scene>_<level>[_core<k>].md``, ``.csv`` and ``.png`` (or into
+``DIR``; a rerun replaces them). ``--reuse-2d`` reads the 2D rows (G, split, J per converged
+step) from the stored ``benchmarks/results/fracture/<scene>_<level>.csv`` instead of solving
+the 2D model again (hours on this machine at medium); ``--core`` sets the beam's
+``[beam_model] core`` (default: the scene's).
 """
 
 from __future__ import annotations
@@ -19,18 +20,15 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.scene_file import load_scene
 
-from sandwich.scene_file import load_scene  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "fracture"
+OUT = RESULTS / "fracture"
 SCENES = {"fig5": "paper-fig5-top-debond-40-load-top", "c2": "paper-fig7-cantilever-c2",
           "c3": "paper-fig7-cantilever-c3"}
 SAMPLES = 8  # probe values compared in the table
@@ -105,13 +103,14 @@ def _monotone(path: tuple[np.ndarray, ...], sign: float) -> tuple[np.ndarray, ..
 
 def main() -> None:
     """Solve, tabulate and plot."""
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--level", default="medium")
     ap.add_argument("--scenes", nargs="+", default=list(SCENES))
     ap.add_argument("--reuse-2d", action="store_true")
     ap.add_argument("--core", default=None, help="beam core level (1…6 or auto)")
+    add_out_argument(ap, OUT)
     args = ap.parse_args()
-    OUT.mkdir(parents=True, exist_ok=True)
+    args.out.mkdir(parents=True, exist_ok=True)
     load = os.getloadavg()[0]
     for key in args.scenes:
         scene = load_scene(ROOT / "scenes" / f"{SCENES[key]}.toml")
@@ -122,13 +121,16 @@ def main() -> None:
             scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
                 scene.beam_model, core=core))
         probe = scene.analysis.until_probe
+        stamp = measured_on() + (" The 2D rows are reused from the stored "
+                                 f"{key}_{args.level}.csv, not solved in this run."
+                                 if args.reuse_2d else "")
         sols, walls = {}, {}
         for model in ("beam", "2d"):
             t0 = time.perf_counter()
             sols[model] = (_stored_2d(OUT / f"{key}_{args.level}", probe)
                            if model == "2d" and args.reuse_2d else _solve(scene, model, args.level))
             walls[model] = time.perf_counter() - t0
-        stem = OUT / (f"{key}_{args.level}" + (f"_core{args.core}" if args.core else ""))
+        stem = args.out / (f"{key}_{args.level}" + (f"_core{args.core}" if args.core else ""))
         with open(f"{stem}.csv", "w", newline="") as fh:
             wr = csv.writer(fh)
             wr.writerow(["model", "tip", "step", "load_factor", probe, "G", "GI", "GII", "J"])
@@ -146,7 +148,7 @@ def main() -> None:
                  f"{sols['2d'].extra.get('vcct_closure_length')} mm, J-integral disc radius "
                  f"{sols['2d'].extra.get('j_radius')} mm. "
                  f"Wall time beam {walls['beam']:.1f} s, 2D {walls['2d']:.1f} s "
-                 f"(load average {load:.2f} at the start).", "",
+                 f"(load average {load:.2f} at the start).", "", stamp, "",
                  f"Beam: {sols['beam'].message}", "", f"2D: {sols['2d'].message}", ""]
         tips = sorted(set(_tips(sols["beam"])) & set(_tips(sols["2d"])))
         sign = np.sign(scene.analysis.until_value)

@@ -3,8 +3,10 @@
 Reads the folder a ``sandwich gallery --out DIR`` run wrote (``DIR/<scene>/metrics.json`` and
 each model's ``summary.json`` / ``history.csv``) and writes one table:
 
-Run: ``.venv/bin/python benchmarks/gallery_agreement.py DIR`` → writes
-``benchmarks/results/comparisons/gallery_agreement.{md,csv}`` (``--out`` to change the stem).
+Run from the project root: ``python -m benchmarks.gallery_agreement DIR [--out OUT]`` → writes
+``benchmarks/results/comparisons/gallery_agreement.{md,csv}`` (or into ``OUT``; a rerun replaces
+them). The table says the machine and date the runs were measured on: this machine (the one
+that tables them) and the time of the newest result file in ``DIR``.
 
 The rows and the table are :mod:`sandwich.compare.agreement` (its docstring names the columns).
 The trust column is not computed: it is the documented reading of each scene (``TRUST`` below,
@@ -18,10 +20,10 @@ import csv
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from sandwich.compare.agreement import fine_check, markdown, scene_row
 
-from sandwich.compare.agreement import fine_check, markdown, scene_row  # noqa: E402
+OUT = RESULTS / "comparisons"
 
 # Where the 2D model is (not) a trustworthy reference, per scene, and why. Sources: README "How
 # far to trust it" (Green-strain core crushing under concentrated loads), docs/comparisons.md
@@ -67,8 +69,7 @@ def main(argv: list[str] | None = None) -> int:
     """Read a gallery folder and write the agreement table (Markdown + CSV)."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("gallery", type=Path, help="the --out folder of a `sandwich gallery` run")
-    p.add_argument("--out", type=Path,
-                   default=ROOT / "benchmarks/results/comparisons/gallery_agreement")
+    add_out_argument(p, OUT)
     p.add_argument("--header", default="", help="run conditions (commit, date, load, times)")
     p.add_argument("--fine", action="append", default=[], metavar="SCENE=DIR",
                    help="a finer 2D run of SCENE (its result folder) to check both models "
@@ -89,13 +90,19 @@ def main(argv: list[str] | None = None) -> int:
     for r in rows:
         if r["scene"] in fine:
             fine_check(r, fine[r["scene"]])
-    a.out.with_suffix(".md").write_text(markdown(rows, str(a.gallery), a.header))
+    newest = max(f.stat().st_mtime for f in a.gallery.rglob("summary.json"))
+    said = (measured_on(newest).removesuffix(".") + " (the machine: the one that tables the "
+            "runs; the date: the newest summary.json).")
+    header = f"{said} {a.header}".strip()
+    a.out.mkdir(parents=True, exist_ok=True)
+    stem = a.out / "gallery_agreement"
+    stem.with_suffix(".md").write_text(markdown(rows, str(a.gallery), header))
     keys = list(dict.fromkeys(k for r in rows for k in r))
-    with a.out.with_suffix(".csv").open("w", newline="") as fh:
+    with stem.with_suffix(".csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, keys)
         w.writeheader()
         w.writerows(rows)
-    print(a.out.with_suffix(".md"))
+    print(stem.with_suffix(".md"))
     return 0
 
 

@@ -14,7 +14,8 @@ snap loads are located by walking the branch its path jumped from (docs/solver.m
 step jumps over"); the Euler load neglects the core's restraint of the tips and the moment's
 variation along the debond, so it is an upper bound the snaps approach as the debond grows.
 
-Run: ``.venv/bin/python benchmarks/knockdown_euler.py [table.csv]``.
+Run from the project root: ``python -m benchmarks.knockdown_euler [table.csv] [--out DIR]``
+(``DIR``: the table's folder unless given; a rerun replaces ``euler.md``).
 """
 
 from __future__ import annotations
@@ -22,15 +23,12 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, ROOT, measured_on
+from sandwich.scene_file import load_scene
 
-from sandwich.scene_file import load_scene  # noqa: E402
-
-DEFAULT = ROOT / "benchmarks" / "results" / "studies" / "fig5-knockdown" / "fig5-knockdown.csv"
+DEFAULT = RESULTS / "studies" / "fig5-knockdown" / "fig5-knockdown.csv"
 SCENE = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
 
 
@@ -49,6 +47,8 @@ def main(argv: list[str] | None = None) -> int:
     """Write the table; return 0."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("table", nargs="?", type=Path, default=DEFAULT)
+    parser.add_argument("--out", type=Path, default=None, metavar="DIR",
+                        help="folder for euler.md (default: the table's)")
     args = parser.parse_args(argv)
     scene = load_scene(SCENE)
     pad = next(iter(scene.loads))
@@ -57,6 +57,7 @@ def main(argv: list[str] | None = None) -> int:
              f"Written by `benchmarks/knockdown_euler.py` from `{args.table.name}`; closed form "
              "in the script's docstring. Debonds that reach within 5 mm of the load pad "
              f"(x = {pad.x:g} ± {pad.width / 2:g} mm) are left out (the pad presses the face).",
+             "", measured_on(verb="Computed") + " The study's run: its summary.md.",
              "", "| length (mm) | centre (mm) | first limit (beam) | Euler load | beam / Euler |",
              "|---|---|---|---|---|"]
     ratios: dict[float, list[float]] = {}
@@ -72,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(f"| {length:g} | {centre:g} | {lam:.1f} | {p_e:.1f} | {lam / p_e:.2f} |")
     lines += ["", "| length (mm) | beam / Euler, range |", "|---|---|"]
     lines += [f"| {k:g} | {min(v):.2f}-{max(v):.2f} |" for k, v in sorted(ratios.items())]
-    out = args.table.parent / "euler.md"
+    out = (args.out or args.table.parent) / "euler.md"
+    out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text("\n".join(lines) + "\n")
     print(out)
     return 0

@@ -1,6 +1,7 @@
 """The table both critical-point benchmarks write: a point read at the state, located, narrowed.
 
-Used by ``critical_location.py`` (bifurcations) and ``maximum_location.py`` (load maxima): each
+Used by ``benchmarks.critical_location`` (bifurcations) and ``benchmarks.maximum_location`` (load
+maxima): each
 row is one path of one case, its point read three ways against the fine path's narrowed value.
 """
 
@@ -41,11 +42,11 @@ def reading_row(case: dict[str, object], how: str, plain: dict, narrow: dict,
 def write_tables(rows: list[dict], out: Path, stem: str, title: str, doc: str,
                  first: tuple[str, str, Callable[[dict], str]], fine: float,
                  load0: tuple[float, ...], error_digits: int = 2,
-                 after: list[str] | None = None) -> None:
+                 after: list[str] | None = None, stamp: str = "") -> None:
     """Write ``<stem>.csv`` and ``<stem>.md`` under ``out``.
 
     ``first``: the first column's header, alignment and cell; ``doc`` the script's description;
-    ``after``: lines below the table.
+    ``after``: lines below the table; ``stamp``: the ``Measured on …`` line.
     """
     out.mkdir(parents=True, exist_ok=True)
     with open(out / f"{stem}.csv", "w", newline="") as f:
@@ -59,7 +60,7 @@ def write_tables(rows: list[dict], out: Path, stem: str, title: str, doc: str,
     err = "{:+." + str(error_digits) + "f} %"
     head, align, cell = first
     lines = [
-        f"# {title}", "", doc, "",
+        f"# {title}", "", doc, "", *([stamp, ""] if stamp else []),
         f"Load average at start {load0[0]:.2f}, at end {os.getloadavg()[0]:.2f} (2 cores). "
         f"Fine paths: displacement steps ≤ {fine} mm. Seconds: the beam run in process, "
         "without / with narrowing.",

@@ -1,8 +1,9 @@
 """Load maxima located within their step, against fine-step paths (sandwich.solver.extrema).
 
-``python benchmarks/maximum_location.py`` writes ``benchmarks/results/beam/maximum_location.md``
-and ``.csv``. Beam paths with a load maximum before their target, each followed twice, and its
-first maximum read off three ways:
+``python -m benchmarks.maximum_location [--out DIR]`` (from the project root) writes
+``benchmarks/results/beam/maximum_location.md`` and ``.csv`` (a rerun replaces them). Beam
+paths with a load maximum before their target, each followed twice, and its first maximum read
+off three ways:
 
 - paths: as the scene has it (arc-length, the beam's settling allowance); displacement control
   of the until probe in steps of at most ``--fine`` mm to the same target (the reference);
@@ -28,18 +29,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))  # run from a checkout, not installed
+from benchmarks.location_table import reading_row, write_tables
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.scene_file import load_scene
 
-from location_table import reading_row, write_tables  # noqa: E402
-
-from sandwich.scene_file import load_scene  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 FIG5 = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
 
 
@@ -100,9 +96,9 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     p.add_argument("--fine", type=float, default=0.05, help="fine path's step cap (mm)")
-    p.add_argument("--out", type=Path, default=OUT)
+    add_out_argument(p, OUT)
     args = p.parse_args(argv)
-    load0 = os.getloadavg()
+    load0, stamp = os.getloadavg(), measured_on()
     rows = []
     for name in args.cases:
         scene = CASES[name]()
@@ -120,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
     write_tables(rows, args.out, "maximum_location",
                  "First load maxima located within their step (benchmarks/maximum_location.py)",
                  __doc__.split("\n\n", 1)[1].strip(), ("case", "---", lambda r: r["case"]),
-                 args.fine, load0, error_digits=3, after=after)
+                 args.fine, load0, error_digits=3, after=after, stamp=stamp)
     return 0
 
 

@@ -9,12 +9,13 @@ level; the 2D rows mesh only (``sandwich mesh``) or solve ``max_steps = 2`` step
 and refinement. The 1-minute load average is recorded before and after each row (the machine has
 2 cores shared with other jobs: the seconds are indicative, the megabytes are not disturbed).
 
-The measurements are kept in ``benchmarks/results/memory/memory_guard.json``; ``--table`` renders
-the table again from them with the current estimate (no solve), so that the constants of the
-estimate and the table they were fitted to stay together.
+The measurements are kept in ``benchmarks/results/memory/memory_guard.json`` (or ``--out DIR``),
+with the machine and date they were measured on; ``--table`` renders the table again from them
+with the current estimate (no solve), so that the constants of the estimate and the table they
+were fitted to stay together. From the project root:
 
-    .venv/bin/python benchmarks/memory_guard.py            # measure every row, write the table
-    .venv/bin/python benchmarks/memory_guard.py --table    # re-render with the current estimate
+    python -m benchmarks.memory_guard            # measure the rows not measured yet, the table
+    python -m benchmarks.memory_guard --table    # re-render with the current estimate
 """
 
 from __future__ import annotations
@@ -30,9 +31,9 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-OUT = ROOT / "benchmarks" / "results" / "memory"
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, machine
+
+OUT = RESULTS / "memory"
 UNTIL = -0.5  # mm: a short path (a handful of steps)
 
 # Rows: (role, ...). "fit" rows set the constants of sandwich/models/memory.py (least squares on the
@@ -222,6 +223,9 @@ def table(rows: list[dict], meta: dict, constants: dict[str, float]) -> str:
     mib = 2**20
     now = {k: getattr(memory, k) for k in constants}
     lines = ["# Peak memory of the command line against the guard's estimate", "",
+             f"Measured on {meta.get('machine', 'an unnamed machine')}, {meta['date']}."
+             + (f" Beam and import rows measured again on {meta['beam_rows_machine']}, "
+                f"{meta['beam_rows_again']}." if "beam_rows_machine" in meta else ""), "",
              f"Measured {meta['date']}"
              + (f" (the beam rows and the import row again {meta['beam_rows_again']}, with the "
                 "kernels of the ahead-of-time build: no numba in the process)"
@@ -275,26 +279,27 @@ def main() -> None:
     ap.add_argument("--again", action="store_true", help="measure every row again")
     ap.add_argument("--again-beam", action="store_true",
                     help="measure the beam rows (and the import row) again, keep the 2D ones")
+    add_out_argument(ap, OUT)
     args = ap.parse_args()
-    OUT.mkdir(parents=True, exist_ok=True)
-    store = OUT / "memory_guard.json"
+    args.out.mkdir(parents=True, exist_ok=True)
+    store = args.out / "memory_guard.json"
     data = json.loads(store.read_text()) if store.is_file() and not args.again else None
     if data is not None and args.again_beam:
         data["rows"] = [r for r in data["rows"] if r["kind"] not in ("beam", "import")]
         data["meta"] = {**data["meta"], "beam_rows_again": time.strftime(
-            "%Y-%m-%d %H:%M UTC", time.gmtime())}
+            "%Y-%m-%d %H:%M UTC", time.gmtime()), "beam_rows_machine": machine()}
     if not args.table:
         mem = Path("/proc/meminfo").read_text()
         total = int(re.search(r"MemTotal:\s+(\d+)", mem).group(1)) * 1024
         meta = (data or {}).get("meta") or {
             "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-            "cpus": os.cpu_count(), "mem_total_gb": total / 1e9}
+            "cpus": os.cpu_count(), "mem_total_gb": total / 1e9, "machine": machine()}
         data = {"meta": meta, "rows": run_rows((data or {}).get("rows", []))}
         store.write_text(json.dumps(data, indent=1))
     constants = fit(data["rows"])
     print(json.dumps(constants, indent=1))
     text = table(data["rows"], data["meta"], constants)
-    (OUT / "memory_guard.md").write_text(text)
+    (args.out / "memory_guard.md").write_text(text)
     print(text)
 
 

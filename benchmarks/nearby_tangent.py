@@ -1,7 +1,8 @@
 """A/B of the beam's nearby evaluation: after a converged increment the layers' tangent is kept.
 
-Run: ``.venv/bin/python benchmarks/nearby_tangent.py [--scenes NAME ...] [--levels auto 1 3]``.
-Writes ``benchmarks/results/beam/nearby_tangent.{md,csv}``.
+Run from the project root: ``python -m benchmarks.nearby_tangent [--scenes NAME ...] [--levels
+auto 1 3] [--out DIR]``. Writes ``benchmarks/results/beam/nearby_tangent.{md,csv}`` (a rerun
+replaces them).
 
 Each scene is solved in this process (kernels warm) twice per core setting, alternately: with
 :meth:`sandwich.beam.model.BeamModel.internal_force_nearby` (as shipped) and with it removed
@@ -15,15 +16,13 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import time
-from pathlib import Path
 
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
 from sandwich.beam import run
 from sandwich.beam.model import BeamModel
 from sandwich.scene_file import load_scene
 
-ROOT = Path(__file__).resolve().parent.parent
-OUT = ROOT / "benchmarks" / "results" / "beam"
+OUT = RESULTS / "beam"
 DEFAULT_SCENES = ("default", "paper-fig5-top-debond-40-load-top",
                   "paper-fig6-top-debond-20-load-bottom", "paper-fig7-cantilever-c3",
                   "paper-fig9-clamped-d20", "paper-fig9-clamped-d40")
@@ -46,7 +45,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", nargs="*", default=list(DEFAULT_SCENES))
     parser.add_argument("--levels", nargs="*", default=["auto"])
+    add_out_argument(parser, OUT)
     args = parser.parse_args()
+    stamp = measured_on()
     rows = []
     start_load = os.getloadavg()[0]
     for name in args.scenes:
@@ -74,8 +75,8 @@ def main() -> None:
             rows.append(row)
             print(row, flush=True)
     end_load = os.getloadavg()[0]
-    OUT.mkdir(parents=True, exist_ok=True)
-    with open(OUT / "nearby_tangent.csv", "w", newline="") as fh:
+    args.out.mkdir(parents=True, exist_ok=True)
+    with open(args.out / "nearby_tangent.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
@@ -84,7 +85,7 @@ def main() -> None:
         "Iterations after a converged increment: every iterate evaluated in full (before) "
         "against the layers' tangent kept and the contact law re-evaluated (after, as shipped; "
         "`BeamModel.internal_force_nearby`, docs/beam_speed.md). In process, kernels warm, "
-        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; 1-minute load average "
+        f"{stamp.rstrip('.')}; 1-minute load average "
         f"{start_load:.2f} at the start, {end_load:.2f} at the end (2 cores).", "",
         "| scene | core | before (s) | after (s) | speed-up | steps before / after | "
         "iterations before / after | end load before / after | max rel. diff of λ over the path |",
@@ -94,7 +95,7 @@ def main() -> None:
         lines.append(f"| {r['scene']} | {r['core']} | {r['before_s']} | {r['after_s']} | "
                      f"{r['speed_up']}× | {r['steps']} | {r['iterations']} | {r['end_load']} | "
                      f"{r['max_rel_diff']} |")
-    (OUT / "nearby_tangent.md").write_text("\n".join(lines) + "\n")
+    (args.out / "nearby_tangent.md").write_text("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

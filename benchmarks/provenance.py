@@ -34,10 +34,13 @@ def machine(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
     return f"{model or platform.machine() or 'unknown CPU'}, {os.cpu_count()} CPUs"
 
 
-def measured_on(when: float | None = None) -> str:
-    """The sentence ``Measured on <machine>, <YYYY-MM-DD HH:MM> UTC.`` (``when``: epoch s; now)."""
+def measured_on(when: float | None = None, verb: str = "Measured") -> str:
+    """The sentence ``Measured on <machine>, <YYYY-MM-DD HH:MM> UTC.`` (``when``: epoch s; now).
+
+    ``verb`` names what was done there and then (``Computed`` for a table derived from another).
+    """
     stamp = time.strftime("%Y-%m-%d %H:%M", time.gmtime(when))
-    return f"Measured on {machine()}, {stamp} UTC."
+    return f"{verb} on {machine()}, {stamp} UTC."
 
 
 def console_script(name: str) -> Path:

@@ -11,9 +11,10 @@ the residual stops decreasing or at --max-iterations). Logged per iteration: ‖
 iterate, the ratio ‖R_{k+1}‖/‖R_k‖² (bounded for quadratic convergence) and the observed order
 log(r_{k+1}/r_k)/log(r_k/r_{k-1}).
 
-Writes benchmarks/results/reference2d/newton_log.{md,json}.
+Writes benchmarks/results/reference2d/newton_log.{md,json} (or into ``--out DIR``; a rerun
+replaces them). From the project root:
 
-    XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/reference2d_newton_log.py [--until -5]
+    python -m benchmarks.reference2d_newton_log [--until -5] [--out DIR]
 """
 
 from __future__ import annotations
@@ -23,15 +24,13 @@ import dataclasses
 import json
 import math
 import os
-from pathlib import Path
 
 import numpy as np
 
-from sandwich.plane2d import solve
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
 from sandwich.scene_file import load_scene
 
-ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "benchmarks" / "results" / "reference2d"
+OUT = RESULTS / "reference2d"
 SCENE = "paper-fig5-top-debond-40-load-top"
 
 
@@ -116,14 +115,18 @@ def md_table(rows: list[dict]) -> list[str]:
 
 
 def main():
-    p = argparse.ArgumentParser()
+    """Follow the path to the start state, run the fixed-load Newton logs, write them."""
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--until", type=float, default=-5.0, help="w_top_mid of the start state (mm)")
     p.add_argument("--level", default="coarse")
     p.add_argument("--dlam-factor", type=float, nargs="+", default=[0.25, 1.0, 4.0],
                    help="step sizes as multiples of the path's last load increment")
     p.add_argument("--max-iterations", type=int, default=15)
-    p.add_argument("--out", default="newton_log")
+    add_out_argument(p, OUT)
     args = p.parse_args()
+    stamp = measured_on()
+    from sandwich.plane2d import solve  # FEniCSx: imported when the log is run
+
     scene = load_scene(ROOT / "scenes" / f"{SCENE}.toml")
     scene = dataclasses.replace(scene, analysis=dataclasses.replace(
         scene.analysis, until_value=args.until))
@@ -143,6 +146,7 @@ def main():
         "residual_roundoff_bound": sol.extra["residual_roundoff_bound"],
         "contact_penalty": sol.extra["contact_penalty"], "path_iterations": path_its,
         "path_load_increment": lam_n - lam_prev, "loadavg": os.getloadavg(),
+        "measured": stamp,
     }
     # round-off level of the residual: the a-priori bound (relative) times the load
     floor = head["residual_roundoff_bound"] * system.norm(lam_n * system.f_ref)
@@ -162,8 +166,8 @@ def main():
                      "dlam": dlam, "rows": rows})
         print(f"{title}: λ {lam0:.6g} → {lam0 + dlam:.6g}")
         print("\n".join(md_table(rows)), flush=True)
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / f"{args.out}.json").write_text(json.dumps({**head, "logs": logs}, indent=2) + "\n")
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "newton_log.json").write_text(json.dumps({**head, "logs": logs}, indent=2) + "\n")
     lines = [
         f"# Newton log, fig5 ({SCENE}), level {args.level}, contact active",
         "",
@@ -176,12 +180,12 @@ def main():
         f"{floor:.2g} N at λ_n). Full Newton at fixed load from the tangent "
         f"predictor, no line search; `changed` = lip nodes whose contact status differs from "
         f"the previous iterate.",
-        ""]
+        "", stamp, ""]
     for log in logs:
         lam0 = log["start_load_factor"]
         lines += [f"## {log['title']}: λ = {lam0:.6g} → {lam0 + log['dlam']:.6g}", ""]
         lines += md_table(log["rows"]) + [""]
-    (OUT / f"{args.out}.md").write_text("\n".join(lines))
+    (args.out / "newton_log.md").write_text("\n".join(lines))
 
 
 if __name__ == "__main__":

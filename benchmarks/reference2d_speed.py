@@ -16,16 +16,18 @@ rank 0, accumulated over the run):
 - ``other``: the rest of the wall time (path solver, admissibility check, probes, profiles,
   field frame).
 
-Every (scene, level, ranks) row runs in its own process (``python this.py --worker`` or
-``mpirun -n 2 --oversubscribe python this.py --worker``), with a wall-clock limit
+Every (scene, level, ranks) row runs in its own process (``python -m
+benchmarks.reference2d_speed --worker`` or ``mpirun -n 2 --oversubscribe python -m
+benchmarks.reference2d_speed --worker``, from the project root), with a wall-clock limit
 (``--timeout``): a row over the limit is reported as not finished. The 1-minute load average
 (``os.getloadavg()``) is recorded before and after every row: on a shared 2-core machine the
 timings are disturbed by other jobs, and 2 ranks on 2 cores compete with them.
 
-Writes benchmarks/results/reference2d/<out>.{md,json}.
+Writes benchmarks/results/reference2d/speed.{md,json} (or into ``--out DIR``; a rerun replaces
+them), with the machine and date measured on. From the project root:
 
-    XDG_CACHE_HOME=.cache .venv/bin/python benchmarks/reference2d_speed.py \
-        [--levels coarse medium fine] [--ranks 1 2] [--until -5] [--out speed]
+    python -m benchmarks.reference2d_speed [--levels coarse medium fine] [--ranks 1 2]
+        [--until -5] [--out DIR]
 """
 
 from __future__ import annotations
@@ -41,8 +43,9 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "benchmarks" / "results" / "reference2d"
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+
+OUT = RESULTS / "reference2d"
 SCENES = ("paper-fig4-bonded-3pb", "paper-fig5-top-debond-40-load-top")
 UNTIL = -5.0
 PHASES = ("mesh", "setup", "residual", "tangent", "factorize", "fsolve", "contact")
@@ -136,7 +139,7 @@ def launch(name: str, level: str, ranks: int, args) -> dict:
     """One row in a fresh process (under mpirun for ranks > 1), with the load averages."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "row.json"
-        cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--scene", name,
+        cmd = [sys.executable, "-m", "benchmarks.reference2d_speed", "--worker", "--scene", name,
                "--level", level, "--until", repr(args.until), "--json", str(out)]
         if args.full:
             cmd.append("--full")
@@ -164,7 +167,7 @@ def launch(name: str, level: str, ranks: int, args) -> dict:
         return row
 
 
-def table(rows: list[dict], args) -> str:
+def table(rows: list[dict], args, stamp: str = "") -> str:
     target = "the scene's target" if args.full else f"w_top_mid = {args.until} mm"
     head = ("| scene | level | ranks | DOFs | steps | Newton its | s/step | total s | CPU s | "
             "mesh | setup | residual | tangent | factorise | MUMPS solve | other | (contact) | "
@@ -174,7 +177,8 @@ def table(rows: list[dict], args) -> str:
              "`total s` is the solve's wall time (no interpreter start-up, no MPI launch), "
              "`CPU s` rank 0's CPU time in it (less disturbed by other jobs than wall time); "
              "load average = 1-minute `os.getloadavg()` before and after the row (2-core "
-             "machine shared with other jobs: timings are disturbed).", "", head,
+             "machine shared with other jobs: timings are disturbed).", "",
+             *([stamp, ""] if stamp else []), head,
              "|" + "---|" * 18]
     short = {"paper-fig4-bonded-3pb": "fig4", "paper-fig5-top-debond-40-load-top": "fig5"}
     for r in rows:
@@ -197,14 +201,15 @@ def table(rows: list[dict], args) -> str:
 
 
 def main():
-    p = argparse.ArgumentParser()
+    """Measure every row in its own process (or be that process: ``--worker``)."""
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--levels", nargs="+", default=["coarse", "medium", "fine"])
     p.add_argument("--ranks", nargs="+", type=int, default=[1, 2])
     p.add_argument("--scenes", nargs="+", default=list(SCENES))
     p.add_argument("--full", action="store_true", help="the scenes' full paths")
     p.add_argument("--until", type=float, default=UNTIL, help="w_top_mid target (mm)")
     p.add_argument("--timeout", type=float, default=1800.0, help="seconds per row")
-    p.add_argument("--out", default="speed", help="file stem under benchmarks/results/reference2d")
+    add_out_argument(p, OUT)
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--scene", help=argparse.SUPPRESS)
     p.add_argument("--level", help=argparse.SUPPRESS)
@@ -213,7 +218,8 @@ def main():
     if args.worker:
         worker(args)
         return
-    OUT.mkdir(parents=True, exist_ok=True)
+    args.out.mkdir(parents=True, exist_ok=True)
+    stamp = measured_on()
     rows = []
     for level in args.levels:  # level-major: the cheap rows first
         for name in args.scenes:
@@ -223,9 +229,9 @@ def main():
                       flush=True)
                 rows.append(r)
                 # written after every row: a long run that is stopped keeps what it measured
-                (OUT / f"{args.out}.json").write_text(json.dumps(rows, indent=2) + "\n")
-                (OUT / f"{args.out}.md").write_text(table(rows, args))
-    print(table(rows, args))
+                (args.out / "speed.json").write_text(json.dumps(rows, indent=2) + "\n")
+                (args.out / "speed.md").write_text(table(rows, args, stamp))
+    print(table(rows, args, stamp))
 
 
 if __name__ == "__main__":

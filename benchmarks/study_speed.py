@@ -1,11 +1,12 @@
 """Study engine speed: the shipped knock-down study's beam cases on 1 and 2 local workers and on a
 2-worker Dask LocalCluster given by address.
 
-Run: ``.venv/bin/python benchmarks/study_speed.py [--study FILE] [--limit N]``. Each
+Run from the project root: ``python -m benchmarks.study_speed [--study FILE] [--limit N] [--out
+DIR]``. Each
 configuration solves every case from scratch (a fresh study folder; no reuse) with the 2D checks
 off (beam cases only: the checks' error indicator and 2D runs are not timed here), then a rerun
 into the same folder times the resume (every case reused). Writes
-``benchmarks/results/studies/study_speed.{csv,md}``.
+``benchmarks/results/studies/study_speed.{csv,md}`` (a rerun replaces them).
 
 The machine is shared (2 cores, other agents' jobs running): every row records ``uptime``'s load
 before and after.
@@ -17,19 +18,16 @@ import argparse
 import csv
 import dataclasses
 import os
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
+from sandwich.studies.study import run_study
+from sandwich.studies.study_file import load_study
+from sandwich.studies.study_report import crossings
 
-from sandwich.studies.study import run_study  # noqa: E402
-from sandwich.studies.study_file import load_study  # noqa: E402
-from sandwich.studies.study_report import crossings  # noqa: E402
-
-OUT = ROOT / "benchmarks" / "results" / "studies"
+OUT = RESULTS / "studies"
 
 
 def _load() -> str:
@@ -42,8 +40,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--study", type=Path,
                     default=ROOT / "studies" / "shipped" / "fig5-knockdown.toml")
     ap.add_argument("--limit", type=int, default=None, help="only the first N cases")
-    ap.add_argument("--out", type=Path, default=OUT)
+    add_out_argument(ap, OUT)
     args = ap.parse_args(argv)
+    stamp = measured_on()
     study = load_study(args.study)
     study = dataclasses.replace(study, check=0, check_all=False,
                                 cases=study.cases[: args.limit] if args.limit else study.cases)
@@ -96,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
           f"jobs (`uptime` load averages 1/5/15 min before and after each run in the table). "
           f"Wall time includes starting the engine's LocalCluster (not for the cluster given "
           f"by address, started before the clock). `rerun`: the same command again into the "
-          f"same folder (every case reused). Run on {time.strftime('%Y-%m-%d %H:%M UTC')}.", "",
+          f"same folder (every case reused).", "", stamp, "",
           "| configuration | cases | wall (s) | cases/min | mean case (s) | mean solve (s) | "
           "Σ case (s) | rerun (s) | reused | load before | load after |",
           "|---|---|---|---|---|---|---|---|---|---|---|"]

@@ -152,12 +152,9 @@ def test_a_study_whose_cases_cannot_fit_is_refused(tmp_path, monkeypatch, capsys
 
 
 def _benchmark():
-    """``benchmarks/memory_guard.py`` as a module (its fit, its rows, its measuring launcher)."""
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    try:
-        import memory_guard
-    finally:
-        sys.path.remove(str(ROOT / "benchmarks"))
+    """``benchmarks.memory_guard`` (its fit, its rows, its measuring launcher)."""
+    from benchmarks import memory_guard
+
     return memory_guard
 
 
