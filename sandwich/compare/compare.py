@@ -74,6 +74,17 @@ def _debond_spans(scene: Scene, interface: str | None = None) -> list[tuple[floa
             if (interface is None or d.interface == interface) and d.length > 0]
 
 
+def _critical_markers(cmp: Comparison, model: str, probe: str, scale: float
+                      ) -> list[tuple[str, float, float]]:
+    """Markers (label, probe value, load in N) at the critical points ``model`` reported."""
+    summary = cmp.metrics.models.get(model)
+    if summary is None:
+        return []
+    return [(f"{model} {c.kind} {scale * c.load_factor:.4g} N", float(c.probes[probe]),
+             scale * c.load_factor)
+            for c in summary.critical_loads if probe in c.probes]
+
+
 def _path_figures(cmp: Comparison) -> None:
     scale = total_force(cmp.scene)
     sols = cmp.solutions
@@ -86,7 +97,10 @@ def _path_figures(cmp: Comparison) -> None:
             load = series(s, LOAD) * scale
             w = series(s, probe.name)
             curves.append(Curve(f"{model}", w, load))
-            markers += [(f"{model} max", float(w[i]), float(load[i])) for i in limit_loads(load)]
+            markers += _critical_markers(cmp, model, probe.name, scale)
+            if not cmp.metrics.models[model].critical_loads:  # maxima seen on the history only
+                markers += [(f"{model} max", float(w[i]), float(load[i]))
+                            for i in limit_loads(load)]
         until = " (path parameter)" if probe.name == cmp.scene.analysis.until_probe else ""
         panel = Panel("load P (N)", curves, markers=markers)
         png, csv_ = overlay(cmp.out_dir / f"load_{probe.name}.png", [panel],
