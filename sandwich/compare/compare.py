@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sandwich.compare.deformed import draw_face_lines, render_frame
+from sandwich.compare.deformed import draw_face_lines, draw_picture, last_picture, shared_view
 from sandwich.compare.face_lines import face_lines
 from sandwich.compare.metrics import Metrics, compute_metrics
 from sandwich.compare.pair import BEAM, PAIR, REFERENCE
@@ -125,7 +125,8 @@ def _release_figures(cmp: Comparison, abscissa: str) -> None:
         debond, end = tip.split("_")
         panels = [Panel("G (N/mm)", total, title=f"debond {debond}, {end} tip"),
                   Panel("G_I, G_II (N/mm)", parts, title="split (each model's own partition)")]
-        png, csv_ = overlay(cmp.out_dir / f"G_{tip}.png", panels, f"|{abscissa}|",
+        unit = "" if abscissa == LOAD else " (mm)"  # a probe (mm) or the load factor
+        png, csv_ = overlay(cmp.out_dir / f"G_{tip}.png", panels, f"|{abscissa}|{unit}",
                             f"{cmp.scene.name}: energy release rate vs |{abscissa}|")
         cmp.figures.append(png)
         cmp.tables.append(csv_)
@@ -198,15 +199,15 @@ def _profile_figures(cmp: Comparison, abscissa: str) -> None:
 
 
 def _deformed_figures(cmp: Comparison) -> None:
+    pictures = {model: last_picture(run.solution) for model in (REFERENCE, BEAM)
+                if (run := cmp.runs.get(model)) is not None and run.solution is not None}
+    drawn = {model: pic for model, pic in pictures.items() if pic is not None}
+    view = shared_view(list(drawn.values()))  # one scale and colour range for both models
+    for model, pic in drawn.items():
+        cmp.figures.append(draw_picture(pic, cmp.out_dir / f"deformed_{model}.png", view))
     lines, titles = [], []
-    for model in (REFERENCE, BEAM):
-        run = cmp.runs.get(model)
-        if run is None or run.solution is None:
-            continue
-        if run.solution.fields:
-            frame = max(run.solution.fields, key=lambda f: f.step)
-            cmp.figures.append(render_frame(model, frame, cmp.out_dir / f"deformed_{model}.png"))
-        elif model in cmp.chosen_profiles:
+    for model in pictures:
+        if model not in drawn and model in cmp.chosen_profiles:
             c = cmp.chosen_profiles[model]
             lines.append(face_lines(cmp.scene, c.profile, model))
             titles.append(f"{model} (faces from profiles): step {c.profile.step}, "
