@@ -132,14 +132,15 @@ def picture_figure(pic: Picture, view: View | None = None, *, note: str = "") ->
     view = view or shared_view([pic])
     xz = pic.points + view.scale * pic.displacement
     stress = pic.cell_stress()
-    fig, ax = plt.subplots(figsize=(12.0, 4.2), layout="constrained")
+    fig, ax = plt.subplots(figsize=(12.0, 3.6), layout="constrained")
     bars = []
     for region in (CORE, FACES):
         mask = pic.in_region(region)
         if not mask.any() or region not in view.ranges:
             continue
         polys = PolyCollection(xz[pic.cells[mask]], array=stress[mask], cmap=COLOUR_MAPS[region],
-                               norm=Normalize(*view.ranges[region]), edgecolors="none")
+                               norm=Normalize(*view.ranges[region]), edgecolors="face",
+                               linewidths=0.2, antialiaseds=False)
         ax.add_collection(polys)
         bars.append((polys, f"{region} von Mises (MPa)"))
     ax.autoscale_view()
