@@ -92,14 +92,21 @@ def _first_limit(cmp: Comparison, model: str) -> float | None:
 
 
 def buckling_load(cmp: Comparison, model: str) -> tuple[float | None, str]:
-    """The local-buckling load of a path: its first load maximum, else its knee.
+    """The local-buckling load of a path: its first critical point, else maximum, else knee.
 
-    A debonded face that buckles against a core it cannot penetrate may give a knee rather than a
-    maximum (the load keeps rising on a much softer branch). The knee is the start of the first
-    step whose stiffness Δλ/Δ|w| (w: the scene's until probe) falls below ``KNEE_FRACTION`` of
+    A critical point the model reported (a bifurcation or a load maximum, located within its
+    step where the model located it) comes first: the earliest on the path. Without one, the
+    first load maximum detected on the history. A debonded face that buckles against a core
+    it cannot penetrate may give a knee rather than a maximum (the load keeps rising on a much
+    softer branch). The knee is the start of the first step whose stiffness Δλ/Δ|w| (w: the
+    scene's until probe) falls below ``KNEE_FRACTION`` of
     the first step's; it depends on the step sizes, so it brackets the buckling load from below
-    to within one step. Returns ``(λ, "max" | "knee")`` or ``(None, reason)``.
+    to within one step. Returns ``(λ, "bifurcation" | "max" | "knee")`` or ``(None, reason)``.
     """
+    critical = cmp.metrics.models[model].critical_loads
+    if critical:
+        first = min(critical, key=lambda c: (c.step, c.load_factor))
+        return first.load_factor, first.kind
     lim = _first_limit(cmp, model)
     if lim is not None:
         return lim, "max"

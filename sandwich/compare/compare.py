@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sandwich.compare.deformed import draw_face_lines, render_frame
+from sandwich.compare.deformed import draw_face_lines, draw_picture, last_picture, shared_view
 from sandwich.compare.face_lines import face_lines
 from sandwich.compare.metrics import Metrics, compute_metrics
 from sandwich.compare.pair import BEAM, PAIR, REFERENCE
@@ -74,6 +74,17 @@ def _debond_spans(scene: Scene, interface: str | None = None) -> list[tuple[floa
             if (interface is None or d.interface == interface) and d.length > 0]
 
 
+def _critical_markers(cmp: Comparison, model: str, probe: str, scale: float
+                      ) -> list[tuple[str, float, float]]:
+    """Markers (label, probe value, load in N) at the critical points ``model`` reported."""
+    summary = cmp.metrics.models.get(model)
+    if summary is None:
+        return []
+    return [(f"{model} {c.kind} {scale * c.load_factor:.4g} N", float(c.probes[probe]),
+             scale * c.load_factor)
+            for c in summary.critical_loads if probe in c.probes]
+
+
 def _path_figures(cmp: Comparison) -> None:
     scale = total_force(cmp.scene)
     sols = cmp.solutions
@@ -86,7 +97,10 @@ def _path_figures(cmp: Comparison) -> None:
             load = series(s, LOAD) * scale
             w = series(s, probe.name)
             curves.append(Curve(f"{model}", w, load))
-            markers += [(f"{model} max", float(w[i]), float(load[i])) for i in limit_loads(load)]
+            markers += _critical_markers(cmp, model, probe.name, scale)
+            if not cmp.metrics.models[model].critical_loads:  # maxima seen on the history only
+                markers += [(f"{model} max", float(w[i]), float(load[i]))
+                            for i in limit_loads(load)]
         until = " (path parameter)" if probe.name == cmp.scene.analysis.until_probe else ""
         panel = Panel("load P (N)", curves, markers=markers)
         png, csv_ = overlay(cmp.out_dir / f"load_{probe.name}.png", [panel],
@@ -111,7 +125,8 @@ def _release_figures(cmp: Comparison, abscissa: str) -> None:
         debond, end = tip.split("_")
         panels = [Panel("G (N/mm)", total, title=f"debond {debond}, {end} tip"),
                   Panel("G_I, G_II (N/mm)", parts, title="split (each model's own partition)")]
-        png, csv_ = overlay(cmp.out_dir / f"G_{tip}.png", panels, f"|{abscissa}|",
+        unit = "" if abscissa == LOAD else " (mm)"  # a probe (mm) or the load factor
+        png, csv_ = overlay(cmp.out_dir / f"G_{tip}.png", panels, f"|{abscissa}|{unit}",
                             f"{cmp.scene.name}: energy release rate vs |{abscissa}|")
         cmp.figures.append(png)
         cmp.tables.append(csv_)
@@ -184,15 +199,15 @@ def _profile_figures(cmp: Comparison, abscissa: str) -> None:
 
 
 def _deformed_figures(cmp: Comparison) -> None:
+    pictures = {model: last_picture(run.solution) for model in (REFERENCE, BEAM)
+                if (run := cmp.runs.get(model)) is not None and run.solution is not None}
+    drawn = {model: pic for model, pic in pictures.items() if pic is not None}
+    view = shared_view(list(drawn.values()))  # one scale and colour range for both models
+    for model, pic in drawn.items():
+        cmp.figures.append(draw_picture(pic, cmp.out_dir / f"deformed_{model}.png", view))
     lines, titles = [], []
-    for model in (REFERENCE, BEAM):
-        run = cmp.runs.get(model)
-        if run is None or run.solution is None:
-            continue
-        if run.solution.fields:
-            frame = max(run.solution.fields, key=lambda f: f.step)
-            cmp.figures.append(render_frame(model, frame, cmp.out_dir / f"deformed_{model}.png"))
-        elif model in cmp.chosen_profiles:
+    for model in pictures:
+        if model not in drawn and model in cmp.chosen_profiles:
             c = cmp.chosen_profiles[model]
             lines.append(face_lines(cmp.scene, c.profile, model))
             titles.append(f"{model} (faces from profiles): step {c.profile.step}, "

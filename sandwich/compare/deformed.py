@@ -1,21 +1,24 @@
 """Deformed-configuration pictures, from a model's field frame or from face profiles.
 
 Both models fill the one field type :class:`~sandwich.results.FieldFrame` (points, cells,
-displacement, point or cell data): the picture of a model is its last frame, drawn deformed and
-coloured by the von Mises stress the model computed (the beam: per point, second Piola-Kirchhoff;
-the 2D reference: per cell, Cauchy), faces grey (cell data ``region``: 0 core, 1 top face,
-2 bottom face). pyvista renders off screen in a child process, matplotlib when that fails.
+displacement, point or cell data): the picture of a model is its last frame, drawn deformed
+(matplotlib) with the core coloured by its von Mises stress and the faces by theirs, each on
+its own colour bar (the faces carry stresses one to two orders above the core's). The beam's
+stress is per point (second Piola-Kirchhoff), the 2D reference's per cell (Cauchy); cell data
+``region`` tells core (0), top face (1) and bottom face (2).
+
+A comparison draws both models with one deformation scale and one colour range per region
+(:func:`shared_view`), so that equal colours mean equal stresses side by side; the scale is
+stated in each title ("deformation × 1" is true scale). Axes are x and z in mm at equal aspect.
 Without frames, the pictures fall back to the face lines of the profiles
 (:mod:`sandwich.compare.face_lines`).
 
-Drawing only: stresses come from the model; deformation is drawn at true scale.
+Drawing only: stresses and displacements come from the model.
 """
 
 from __future__ import annotations
 
-import subprocess
-import sys
-import tempfile
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,12 +28,18 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.collections import PolyCollection  # noqa: E402
+from matplotlib.colors import Normalize  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
 from sandwich.compare.face_lines import FaceLines  # noqa: E402
 from sandwich.results import FieldFrame, Solution  # noqa: E402
-from sandwich.results.vtu import read_vtu, vtu_text  # noqa: E402
 
 STRESS = "von_mises"
+CORE, FACES = "core", "faces"
+COLOUR_MAPS = {CORE: "viridis", FACES: "magma"}  # one map per region, the same for both models
+VISIBLE_DEFLECTION = 0.25  # magnify until the largest displacement is this × the section depth
+NICE_FACTORS = (1, 2, 5)  # deformation scales are these × a power of ten
 
 
 @dataclass(frozen=True)
@@ -46,6 +55,22 @@ class Picture:
     von_mises: np.ndarray  # (m,) per cell or (n,) per point, MPa
     per_cell: bool
     region: np.ndarray  # (m,) 0 core, 1 top face, 2 bottom face
+
+    def cell_stress(self) -> np.ndarray:
+        """Von Mises per cell (MPa): the cell's own, or the mean of its points'."""
+        return self.von_mises if self.per_cell else self.von_mises[self.cells].mean(axis=1)
+
+    def in_region(self, region: str) -> np.ndarray:
+        """Mask of the cells of ``region`` (``"core"`` or ``"faces"``)."""
+        return self.region == 0 if region == CORE else self.region != 0
+
+
+@dataclass(frozen=True)
+class View:
+    """What pictures drawn side by side share: deformation scale and colour range per region."""
+
+    scale: float
+    ranges: dict[str, tuple[float, float]]  # region -> (min, max) von Mises, MPa
 
 
 def picture_of(model: str, frame: FieldFrame) -> Picture:
@@ -72,102 +97,71 @@ def last_picture(solution: Solution) -> Picture | None:
     return picture_of(solution.model, frame)
 
 
-def render_frame(model: str, frame: FieldFrame, path: Path, *, scale: float = 1.0) -> Path:
-    """Render ``frame`` deformed (× ``scale``), coloured by core von Mises, into ``path``.
+def deformation_scale(pictures: Sequence[Picture]) -> float:
+    """True scale (1) when the largest displacement is visible, else a round magnification.
 
-    pyvista renders in a child process (the frame handed over as VTU): VTK's wheel and the
-    FEniCSx stack loaded in one process have been seen to abort inside VTK (a C++ library
-    clash). If the child fails, the picture is drawn with matplotlib instead, and the title says
-    so.
+    Visible: at least ``VISIBLE_DEFLECTION`` × the section depth; a smaller one is magnified by
+    the smallest of 1, 2, 5 × 10ⁿ that makes it so.
     """
-    pic = picture_of(model, frame)
-    with tempfile.TemporaryDirectory() as tmp:
-        vtu = Path(tmp) / "frame.vtu"
-        vtu.write_text(vtu_text(pic.points, pic.cells, {"displacement": pic.displacement,
-                                                        **({} if pic.per_cell else
-                                                           {STRESS: pic.von_mises})},
-                                {"region": pic.region.astype(float),
-                                 **({STRESS: pic.von_mises} if pic.per_cell else {})}))
-        cmd = [sys.executable, "-m", "sandwich.compare.render_worker", str(vtu), str(path), model,
-               str(pic.step), repr(pic.load_factor), repr(scale)]
-        try:
-            done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-            ok = done.returncode == 0 and Path(path).is_file()
-        except (OSError, subprocess.TimeoutExpired):
-            ok = False
-    return path if ok else draw_picture(pic, path, scale=scale, note="pyvista failed; ")
+    depth = max((float(np.ptp(p.points[:, 1])) for p in pictures), default=0.0)
+    largest = max((float(np.max(np.linalg.norm(p.displacement, axis=1)))
+                   for p in pictures if len(p.displacement)), default=0.0)
+    if depth <= 0 or largest <= 0 or largest >= VISIBLE_DEFLECTION * depth:
+        return 1.0
+    need = VISIBLE_DEFLECTION * depth / largest
+    power = 10.0 ** math.floor(math.log10(need))
+    return next(f * power for f in (*NICE_FACTORS, 10) if f * power >= need)
 
 
-def picture_from_vtu(path: Path, model: str, step: int, load_factor: float) -> Picture:
-    """The picture written by :func:`render_frame` for its child process."""
-    points, cells, point_data, cell_data = read_vtu(path)
-    frame = FieldFrame(step, load_factor, points[:, :2], cells,
-                       point_data.pop("displacement")[:, :2], point_data, cell_data)
-    return picture_of(model, frame)
+def shared_view(pictures: Sequence[Picture]) -> View:
+    """One deformation scale and one colour range per region over ``pictures``."""
+    ranges = {}
+    for region in (CORE, FACES):
+        values = [p.cell_stress()[p.in_region(region)] for p in pictures]
+        values = [v[np.isfinite(v)] for v in values]
+        values = [v for v in values if v.size]
+        if values:
+            lo = min(float(v.min()) for v in values)
+            hi = max(float(v.max()) for v in values)
+            ranges[region] = (lo, hi if hi > lo else lo + 1.0)
+    return View(deformation_scale(pictures), ranges)
 
 
-def draw_picture(pic: Picture, path: Path, *, scale: float = 1.0, note: str = "") -> Path:
-    """Matplotlib picture of the deformed section, core cells coloured by von Mises."""
-    from matplotlib.collections import PolyCollection
-
-    xz = pic.points + scale * pic.displacement
-    vm = pic.von_mises if pic.per_cell else pic.von_mises[pic.cells].mean(axis=1)
-    fig, ax = plt.subplots(figsize=(14, 3.6))
-    core = pic.region == 0
-    polys = PolyCollection(xz[pic.cells[core]], array=vm[core], cmap="viridis",
-                           edgecolors="none")
-    ax.add_collection(polys)
-    ax.add_collection(PolyCollection(xz[pic.cells[~core]], facecolors="gray",
-                                     edgecolors="none"))
-    fig.colorbar(polys, ax=ax, label="core von Mises (MPa)", fraction=0.03)
+def picture_figure(pic: Picture, view: View | None = None, *, note: str = "") -> Figure:
+    """The deformed section of ``pic`` as a matplotlib figure (axes in mm, equal aspect)."""
+    view = view or shared_view([pic])
+    xz = pic.points + view.scale * pic.displacement
+    stress = pic.cell_stress()
+    fig, ax = plt.subplots(figsize=(12.0, 3.6), layout="constrained")
+    bars = []
+    for region in (CORE, FACES):
+        mask = pic.in_region(region)
+        if not mask.any() or region not in view.ranges:
+            continue
+        polys = PolyCollection(xz[pic.cells[mask]], array=stress[mask], cmap=COLOUR_MAPS[region],
+                               norm=Normalize(*view.ranges[region]), edgecolors="face",
+                               linewidths=0.2, antialiaseds=False)
+        ax.add_collection(polys)
+        bars.append((polys, f"{region} von Mises (MPa)"))
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("z (mm)")
-    ax.set_title(f"{note}{pic.model}: step {pic.step}, load factor {pic.load_factor:.4g}",
-                 fontsize=9)
+    shown = " and ".join(region for region in (CORE, FACES) if pic.in_region(region).any())
+    ax.set_title(f"{note}{pic.model}: step {pic.step}, load factor {pic.load_factor:.4g}; "
+                 f"deformation × {view.scale:g}; {shown} shown", fontsize=9)
+    for polys, label in bars:
+        fig.colorbar(polys, ax=ax, orientation="horizontal", location="bottom", label=label,
+                     fraction=0.08, aspect=60, pad=0.02)
+    return fig
+
+
+def draw_picture(pic: Picture, path: Path, view: View | None = None, *, note: str = "") -> Path:
+    """Write :func:`picture_figure` of ``pic`` to ``path`` (PNG)."""
+    fig = picture_figure(pic, view, note=note)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
+    fig.savefig(path, dpi=120)
     plt.close(fig)
-    return path
-
-
-def render_with_pyvista(pic: Picture, path: Path, *, scale: float = 1.0,
-                        window: tuple[int, int] = (1600, 420)) -> Path:
-    """Render in this process with pyvista (off screen); see :func:`render_frame`."""
-    import pyvista as pv
-
-    pv.OFF_SCREEN = True
-    xz = pic.points + scale * pic.displacement
-    pts = np.column_stack([xz[:, 0], np.zeros(len(xz)), xz[:, 1]])
-    k = pic.cells.shape[1]
-    kind = pv.CellType.TRIANGLE if k == 3 else pv.CellType.QUAD
-    conn = np.column_stack([np.full(len(pic.cells), k), pic.cells]).ravel()
-    grid = pv.UnstructuredGrid(conn, np.full(len(pic.cells), kind, dtype=np.uint8), pts)
-    name = "von Mises (MPa)"
-    if pic.per_cell:
-        grid.cell_data[name] = pic.von_mises
-    else:
-        grid.point_data[name] = pic.von_mises
-    plotter = pv.Plotter(off_screen=True, window_size=list(window))
-    plotter.set_background("white")
-    core = grid.extract_cells(np.flatnonzero(pic.region == 0))
-    faces = grid.extract_cells(np.flatnonzero(pic.region != 0))
-    if faces.n_cells:
-        plotter.add_mesh(faces, color="gray")
-    plotter.add_mesh(core, scalars=name, cmap="viridis",
-                     scalar_bar_args={"title": name, "color": "black"})
-    plotter.add_text(f"{pic.model}: step {pic.step}, load factor {pic.load_factor:.4g}",
-                     font_size=10, color="black")
-    plotter.view_xz()
-    plotter.enable_parallel_projection()
-    span_x = float(np.ptp(xz[:, 0])) or 1.0
-    span_z = float(np.ptp(xz[:, 1])) or 1.0
-    # half the visible height: fit the whole length (and height) with a 10 % margin
-    plotter.camera.parallel_scale = 0.55 * max(span_x * window[1] / window[0], span_z)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    plotter.screenshot(str(path))
-    plotter.close()
     return path
 
 

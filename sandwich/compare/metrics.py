@@ -13,6 +13,9 @@ Definitions (all relative errors are of the beam against the 2D reference):
   ``PEAK_WINDOW`` mm (a force per unit length over that window, which converges);
 - limit loads: maxima of the load factor that the path falls from (detected on each history), and
   those the model itself reported;
+- critical loads: the first load maximum and the first bifurcation each model reported (located
+  within their step where the model located them), and the beam's error on each kind that both
+  models reached (:class:`CriticalLoadError`);
 - energy release rate: G along the path at every debond tip both models report
   (:mod:`sandwich.compare.releases`: L2/max error of G, beam/2D ratio and each model's G_II/G at the
   end of the common range);
@@ -48,6 +51,7 @@ from sandwich.models import ModelRun
 from sandwich.results import Solution
 
 PEAK_WINDOW = 5.0  # mm: averaging window of the windowed stress peaks (10 face thicknesses)
+CRITICAL_KINDS = ("bifurcation", "max")  # the critical points compared, in this order
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,26 @@ class LimitLoad:
     step: int
     load_factor: float
     probes: dict[str, float]
+
+
+@dataclass(frozen=True)
+class CriticalLoad:
+    """A critical point a model reported: a load maximum or a bifurcation of its path."""
+
+    kind: str  # "max" | "bifurcation"
+    step: int
+    load_factor: float
+    probes: dict[str, float]
+    located: bool  # located within its step (else: the converged state that ends the step)
+
+
+@dataclass(frozen=True)
+class CriticalLoadError:
+    """The first critical load of one kind in both models, and the beam's relative error."""
+
+    kind: str  # "max" | "bifurcation"
+    load_factor: dict[str, float]  # by model
+    relative_error: float  # (beam − 2D) / |2D|
 
 
 @dataclass(frozen=True)
@@ -74,6 +98,11 @@ class ModelSummary:
     dofs: int | None
     limit_loads: list[LimitLoad]  # detected on the history
     reported_limit_loads: list[LimitLoad]  # as the model reported them (kind "max")
+    critical_loads: list[CriticalLoad] = field(default_factory=list)  # maxima and bifurcations
+
+    def first_critical(self, kind: str) -> CriticalLoad | None:
+        """The first reported critical point of ``kind`` ("max" or "bifurcation") on the path."""
+        return next((c for c in self.critical_loads if c.kind == kind), None)
 
 
 @dataclass
@@ -92,6 +121,7 @@ class Metrics:
     peak_window: float = 0.0  # mm, width of the averaging window of ``peaks_windowed``
     releases: list[ReleaseAgreement] = field(default_factory=list)  # G per debond tip
     first_limit_load_error: float | None = None
+    critical_loads: list[CriticalLoadError] = field(default_factory=list)  # first of each kind
     wall_ratio: float | None = None  # 2D wall time / beam wall time
     dofs_ratio: float | None = None  # 2D DOFs / beam DOFs
 
@@ -146,9 +176,13 @@ def summarize(run: ModelRun) -> ModelSummary:
                 for i in limit_loads(load)]
     reported = [LimitLoad(lp.step, lp.load_factor, dict(lp.probes))
                 for lp in s.limit_points if lp.kind == "max"]
+    critical = [CriticalLoad(lp.kind, lp.step, float(lp.load_factor), dict(lp.probes),
+                             lp.located_at is not None)
+                for lp in s.limit_points
+                if lp.kind in CRITICAL_KINDS and math.isfinite(lp.load_factor)]
     return ModelSummary(run.model, run.origin, run.reason, s.converged, s.message,
                         len(s.history), _finite(s.final_load_factor), _finite(s.wall_seconds),
-                        s.dofs, detected, reported)
+                        s.dofs, detected, reported, critical)
 
 
 def crushed_note(model: str, sol: Solution) -> str:
@@ -196,9 +230,38 @@ def compute_metrics(scene_name: str, runs: dict[str, ModelRun], abscissa: str) -
         metrics.first_limit_load_error = (lb[0].load_factor - lr[0].load_factor) / abs(
             lr[0].load_factor)
     mb, mr = metrics.models[BEAM], metrics.models[REFERENCE]
+    metrics.critical_loads = critical_load_errors(mb, mr)
     metrics.wall_ratio = _ratio(mr.wall_seconds, mb.wall_seconds)
     metrics.dofs_ratio = _ratio(mr.dofs, mb.dofs)
     return metrics
+
+
+def critical_load_errors(beam: ModelSummary, ref: ModelSummary) -> list[CriticalLoadError]:
+    """The first bifurcation and the first load maximum of both models, where both reached one."""
+    out = []
+    for kind in CRITICAL_KINDS:
+        b, r = beam.first_critical(kind), ref.first_critical(kind)
+        if b is None or r is None or r.load_factor == 0:
+            continue
+        out.append(CriticalLoadError(kind, {BEAM: b.load_factor, REFERENCE: r.load_factor},
+                                     (b.load_factor - r.load_factor) / abs(r.load_factor)))
+    return out
+
+
+def critical_lines(metrics: Metrics, total_force: float) -> list[str]:
+    """One console line per critical kind that a model reported: loads in N and the error."""
+    names = {"bifurcation": "first bifurcation", "max": "first load maximum"}
+    lines = []
+    for kind in CRITICAL_KINDS:
+        found = {m: s.first_critical(kind) for m, s in metrics.models.items()}
+        if not any(found.values()):
+            continue
+        parts = [f"{m} {total_force * c.load_factor:.5g} N (λ {c.load_factor:.5g})"
+                 if c is not None else f"{m} none" for m, c in found.items()]
+        err = next((e for e in metrics.critical_loads if e.kind == kind), None)
+        tail = f": beam {100 * err.relative_error:+.2f} % on 2D" if err is not None else ""
+        lines.append(f"{names[kind]}: " + ", ".join(parts) + tail)
+    return lines
 
 
 def _profile_metrics(metrics: Metrics, beam: Solution, ref: Solution, abscissa: str) -> None:

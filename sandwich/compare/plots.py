@@ -21,11 +21,16 @@ from sandwich.compare.paths import Curve  # noqa: E402
 
 STYLE = {"2d": {"linestyle": "-", "color": "C0"}, "beam": {"linestyle": "--", "color": "C3"}}
 EXTRA_COLORS = ("C2", "C1", "C4", "C5", "C6")
+MARKERS = {"2d": "o", "beam": "s"}  # critical points and limit loads, by model
 
 
 @dataclass(frozen=True)
 class Panel:
-    """One axes of a figure: its curves, y label, markers (label, x, y) and shaded x spans."""
+    """One axes of a figure: its curves, y label, markers (label, x, y) and shaded x spans.
+
+    A marker's label starts with its model's name (its colour and symbol) and is shown in the
+    legend.
+    """
 
     ylabel: str
     curves: Sequence[Curve]
@@ -79,14 +84,16 @@ def overlay(path: Path, panels: Sequence[Panel], xlabel: str, title: str) -> tup
             ax.plot(c.x, c.y, label=c.label, linewidth=1.4, **_style(c.label, k))
         for a, b in panel.spans:
             ax.axvspan(a, b, color="0.85", zorder=0)
-        for label, x, y in panel.markers:
-            ax.plot([x], [y], marker="o", markersize=6, fillstyle="none", color="k")
-            ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        for label, x, y in panel.markers:  # in the legend, not as text that may collide
+            model = label.split()[0]
+            ax.plot([x], [y], linestyle="none", marker=MARKERS.get(model, "D"), markersize=7,
+                    fillstyle="none", markeredgewidth=1.4,
+                    color=STYLE.get(model, {}).get("color", "k"), label=label)
         ax.set_ylabel(panel.ylabel)
         if panel.title:
             ax.set_title(panel.title, fontsize=9)
         ax.grid(True, linewidth=0.3)
-        if panel.curves:
+        if panel.curves or panel.markers:
             ax.legend(fontsize=7)
     axes[-1, 0].set_xlabel(xlabel)
     fig.suptitle(title, fontsize=10)

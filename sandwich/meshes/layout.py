@@ -13,7 +13,7 @@ import math
 import warnings
 from dataclasses import dataclass
 
-from sandwich.scene import Scene
+from sandwich.scene import Problem, Scene, SceneError
 
 GEOM_TOL = 1e-9  # mm: coordinates closer than this are the same station
 
@@ -127,12 +127,14 @@ def _snap(entries: list[tuple[float, str, str]], tol: float,
         debond_ends = [e[2] for e in cl if e[1] == "debond"]
         owners = [lbl.split(".")[0] for lbl in debond_ends]
         if len(set(owners)) < len(owners):
-            raise ValueError(f"{owners[0]} is shorter than {tol:g} mm, the smallest debond this "
-                             "mesh level can resolve; remove it (bonded) or use a finer level")
+            raise _Unmeshable(owners[0], f"shorter than {tol:g} mm, the smallest debond this "
+                              "mesh level can resolve; remove it (bonded) or use a finer "
+                              "[reference2d] level")
         sides = [interface[o] for o in owners]
         if len(set(sides)) < len(sides):
-            raise ValueError(f"{' and '.join(owners)} on one interface are less than {tol:g} mm "
-                             "apart (one element): merge them into one debond or use a finer level")
+            raise _Unmeshable(owners[0], f"{' and '.join(owners)} on one interface are less "
+                              f"than {tol:g} mm apart (one element): merge them into one debond "
+                              "or use a finer [reference2d] level")
         for e in cl:
             if abs(e[0] - anchor[0]) > GEOM_TOL:
                 warnings.warn(f"mesh: {e[2]} moved from {e[0]:g} to {anchor[0]:g} mm onto "
@@ -147,14 +149,37 @@ def _check_gaps(cracks: list[Crack], tol: float) -> None:
         same = sorted((c for c in cracks if c.interface == itf), key=lambda c: c.start)
         for c1, c2 in zip(same, same[1:], strict=False):
             if c2.start - c1.end < tol:
-                raise ValueError(
+                raise _Unmeshable(
+                    f"debonds[{c1.index}]",
                     f"debonds[{c1.index}] and debonds[{c2.index}] on the {itf} interface are "
                     f"{c2.start - c1.end:g} mm apart (less than {tol:g} mm, one element): "
-                    "merge them into one debond or use a finer level")
+                    "merge them into one debond or use a finer [reference2d] level")
+
+
+class _Unmeshable(ValueError):
+    """A scene feature the mesh level cannot resolve: the scene key and the reason."""
+
+    def __init__(self, key: str, reason: str):
+        self.key, self.reason = key, reason
+        super().__init__(f"{key}: {reason}")
 
 
 def make_layout(scene: Scene, snap_tolerance: float, half: bool = False) -> Layout:
-    """The stations and features of ``scene``, merged where closer than ``snap_tolerance``."""
+    """The stations and features of ``scene``, merged where closer than ``snap_tolerance``.
+
+    Raises
+    ------
+    SceneError
+        Naming the scene file and key, where a feature is smaller than the level resolves.
+    """
+    try:
+        return _layout(scene, snap_tolerance, half)
+    except _Unmeshable as exc:
+        where = str(scene.source) if scene.source is not None else scene.name
+        raise SceneError([Problem(where, exc.key, exc.reason)]) from None
+
+
+def _layout(scene: Scene, snap_tolerance: float, half: bool) -> Layout:
     L = scene.length
     if half:
         why = symmetry_problem(scene)

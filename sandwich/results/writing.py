@@ -25,6 +25,7 @@ import os
 import re
 import shutil
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -84,9 +85,9 @@ def _extra_cell(extra: dict, name: str) -> object:
     return _cell(value)
 
 
-def history_csv(solution: Solution) -> str:
-    """Render ``history.csv``."""
-    probe_names = list(solution.history[0].probes) if solution.history else []
+def history_csv(solution: Solution, probe_names: Sequence[str] = ()) -> str:
+    """Render ``history.csv``; ``probe_names`` head its columns when no step converged."""
+    probe_names = list(solution.history[0].probes) if solution.history else list(probe_names)
     extra_names = sorted({k for r in solution.history for k in r.extra})
     header = ["step", "load_factor", *probe_names, "iterations", *extra_names]
     rows = [
@@ -146,7 +147,7 @@ def result_texts(solution: Solution, scene: object | None = None) -> dict[str, s
     (:mod:`sandwich.results.tractions`).
     """
     files = {
-        "history.csv": history_csv(solution),
+        "history.csv": history_csv(solution, [p.name for p in getattr(scene, "probes", ())]),
         "profiles.csv": profiles_csv(solution),
         "summary.json": json.dumps(summary_dict(solution), indent=2, allow_nan=False) + "\n",
     }

@@ -421,7 +421,8 @@ def load_study(path: str | Path) -> Study:
         p.fail("axis", f"{n} cases: more than {MAX_CASES}")
     if p.items:
         raise StudyError(p.items)
-    cases, refused = [], []
+    cases: list[Case] = []
+    refused: dict[tuple[str, ...], list[str]] = {}  # the problems -> the cases that give them
     for index, combo in enumerate(itertools.product(*(a.values for a in axes))):
         values = dict(zip((a.name for a in axes), combo, strict=True))
         case_data = apply(base, axes, values)
@@ -432,18 +433,16 @@ def load_study(path: str | Path) -> Study:
         try:
             scene = build_scene(case_data, fname, source=None)
         except SceneError as exc:
-            refused.append(f"case {index} ({_fmt(values)}) gives a scene the checks refuse: "
-                           + "; ".join(f"{q.key}: {q.reason}" for q in exc.problems[:3]))
+            why = tuple(f"{q.key}: {q.reason}" for q in exc.problems[:3])
+            refused.setdefault(why, []).append(f"case {index} ({_fmt(values)})")
             continue
         except (ValueError, TypeError, KeyError, ZeroDivisionError) as exc:
-            refused.append(f"case {index} ({_fmt(values)}) cannot be built: {exc}")
+            refused.setdefault((f"cannot be built: {exc}",), []).append(
+                f"case {index} ({_fmt(values)})")
             continue
         spec = get_model(model)
         cases.append(Case(index, values, scene, case_key(scene, model, spec.options(scene))))
-    for line in refused[:MAX_SHOWN]:
-        p.fail("axis", line)
-    if len(refused) > MAX_SHOWN:
-        p.fail("axis", f"... and {len(refused) - MAX_SHOWN} more refused cases")
+    _report_refused(p, refused, n, tables)
     if p.items:
         raise StudyError(p.items)
     return Study(name=name, description=description, source=path, scene_path=scene_path,
@@ -451,6 +450,31 @@ def load_study(path: str | Path) -> Study:
                  cases=tuple(cases), check_options=dict(tables["reference2d"]),
                  check_all=check_all, timeout=None if timeout is None else float(timeout),
                  max_cells=max_cells, fields=fields)
+
+
+def _report_refused(p: _Problems, refused: dict[tuple[str, ...], list[str]], n: int,
+                    tables: dict[str, dict[str, Any]]) -> None:
+    """One problem per distinct reason the checks gave, not one per case.
+
+    A reason every case gives, about a key the study's own tables set (``[beam_model]``,
+    ``[reference2d]``, ``[analysis]``), is that table's key; any other names the axes and
+    the first cases that give it.
+    """
+    for shown, (why, which) in enumerate(refused.items()):
+        if shown == MAX_SHOWN:
+            p.fail("axis", f"... and {len(refused) - MAX_SHOWN} more reasons")
+            return
+        key = why[0].split(":", 1)[0]
+        table = key.split(".", 1)[0]
+        if len(which) == n and table in tables and key.split(".", 1)[-1] in tables[table]:
+            for reason in why:
+                k, _, r = reason.partition(": ")
+                p.fail(k, f"{r} (the study's [{table}] table, for every case)")
+            continue
+        cases = ", ".join(which[:3]) + (f" and {len(which) - 3} more" if len(which) > 3 else "")
+        verb = "cases give" if len(which) > 1 else "case gives"
+        p.fail("axis", f"{len(which)} of {n} {verb} a scene the checks refuse "
+                       f"({'; '.join(why)}): {cases}")
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -214,6 +214,22 @@ DERIVED: dict[str, Callable[[dict[str, Any], float, dict[str, Any]], None]] = {
     "thickness_ratio": _thickness_ratio,
     "slenderness": _slenderness,
 }
+# the unit of each derived parameter's values ("" for a ratio)
+DERIVED_UNITS = {"debond_length": "mm", "debond_centre": "mm", "periodic_debonds": "mm",
+                 "core_stiffness_ratio": "", "thickness_ratio": "", "slenderness": ""}
+# the unit of a scene path's value, by its last key (the scene format's units: mm, MPa, N)
+PATH_UNITS = {"start": "mm", "end": "mm", "x": "mm", "length": "mm", "thickness": "mm",
+              "width": "mm", "value": "mm", "E": "MPa", "Ex": "MPa", "Ez": "MPa", "G": "MPa",
+              "Gzx": "MPa", "force": "N"}
 # the extra keys each derived parameter reads from its axis table
 DERIVED_KEYS = {"debond_length": ("debond",), "debond_centre": ("debond",),
                 "periodic_debonds": ("centre", "interfaces")}
+
+
+def axis_label(name: str, path: str | None, derived: str | None, scale: bool) -> str:
+    """An axis title with its unit: ``"length (mm)"``, ``"Ex (× base)"``, ``"ratio"``."""
+    if scale:
+        return f"{name} (× base value)"
+    unit = DERIVED_UNITS.get(derived or "", "") if derived else PATH_UNITS.get(
+        (path or "").rsplit(".", 1)[-1], "")
+    return f"{name} ({unit})" if unit else name

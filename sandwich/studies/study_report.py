@@ -14,7 +14,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from sandwich.studies.study_file import Study, reference_case
+from sandwich.studies.study_file import Axis, Study, reference_case
+from sandwich.studies.study_params import axis_label
 
 METRICS = ("initial_stiffness", "first_limit_kind", "first_limit_load", "first_limit_w",
            "load_at_until", "capacity", "peak_sigma_zz", "peak_sigma_zz_5mm", "peak_tau_core",
@@ -115,16 +116,30 @@ def crossings(study: Study, table: list[dict[str, Any]]) -> list[dict[str, Any]]
         below = r if at is not None else None
         out.append({**{a.name: v for a, v in zip(others, key, strict=True)}, "at": at,
                     "after": None if prev is None else prev[first.name],
+                    "value": None if below is None else _num(below.get(study.report.quantity)),
                     "kind": (below.get("first_limit_kind") or "no limit point before the "
                              "target") if below is not None else ""})
     return out
 
 
 def plot(study: Study, table: list[dict[str, Any]], out: Path) -> list[Path]:
-    """The knock-down curve (one axis) or heat map (two axes); 2D-checked cases circled.
+    """Write :func:`figures` into ``out`` (PNG); returns the files written."""
+    import matplotlib.pyplot as plt
+
+    written = []
+    for name, fig in figures(study, table):
+        path = out / name
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        written.append(path)
+    return written
+
+
+def figures(study: Study, table: list[dict[str, Any]]) -> list[tuple[str, Any]]:
+    """The knock-down curve (one axis) or heat map (two axes), 2D-checked cases circled.
 
     With more than two axes the first two are mapped, one map per value of the third (at the
-    other axes' first values). Returns the files written.
+    other axes' first values). Returns ``(file name, matplotlib figure)`` pairs.
     """
     import matplotlib
 
@@ -136,7 +151,7 @@ def plot(study: Study, table: list[dict[str, Any]], out: Path) -> list[Path]:
     show = "knockdown" if study.report.reference else q
     label = (f"knock-down: {q} / {q} at {_fmt(study.report.reference)}" if show == "knockdown"
              else f"{q} ({UNITS.get(q, '')})")
-    written: list[Path] = []
+    written: list[tuple[str, Any]] = []
     numeric = all(all(isinstance(v, int | float) for v in a.values) for a in study.axes[:2])
     if len(study.axes) == 1 or not numeric:
         a = study.axes[0]
@@ -167,32 +182,29 @@ def plot(study: Study, table: list[dict[str, Any]], out: Path) -> list[Path]:
                 if v is not None and ref:  # the 2D knock-down needs the 2D reference too
                     ax.plot([x], [v / ref], "x", color="red", ms=8)
         if study.report.threshold is not None and show == "knockdown":
-            ax.axhline(study.report.threshold, color="grey", ls="--", lw=1)
-        ax.set_xlabel(a.name)
+            ax.axhline(study.report.threshold, color="grey", ls="--", lw=1,
+                       label=f"threshold {study.report.threshold:g}")
+        ax.set_xlabel(_axis_title(a))
         ax.set_ylabel(label)
-        if len(groups) > 1 and len(groups) <= 12:
+        _legend_of_checks(ax, table, q, two_d_marks=show == "knockdown")
+        if 1 < len(groups) <= 12 or ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)
-        ax.set_title(f"{study.name}: red circles = checked with the 2D model, beam-vs-2D error "
-                     f"of {q} (x: the 2D value, where the 2D model checked the reference too)",
-                     fontsize=7)
+        ax.set_title(_wrapped(f"{study.name}: {label} over {a.name}"), fontsize=9)
         fig.tight_layout()
-        path = out / f"{study.name}-curve.png"
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return [path]
+        return [(f"{study.name}-curve.png", fig)]
     a, b = study.axes[0], study.axes[1]
     rest = study.axes[2:]
     slices = [()] if not rest else [(v,) for v in rest[0].values]
     for sl in slices:
         rs = [r for r in table if all(r[c.name] == c.values[0] for c in rest[1:])
               and (not sl or r[rest[0].name] == sl[0])]
-        X = np.array(a.values, dtype=float)
-        Y = np.array(b.values, dtype=float)
+        X = np.sort(np.array(a.values, dtype=float))
+        Y = np.sort(np.array(b.values, dtype=float))
         Z = np.full((len(Y), len(X)), np.nan)
         for r in rs:
             v = _num(r.get(show))
             if v is not None:
-                Z[b.values.index(r[b.name]), a.values.index(r[a.name])] = v
+                Z[np.searchsorted(Y, float(r[b.name])), np.searchsorted(X, float(r[a.name]))] = v
         fig, ax = plt.subplots(figsize=(7, 4.6))
         mesh = ax.pcolormesh(_edges(X), _edges(Y), Z, shading="flat", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label=label)
@@ -207,22 +219,24 @@ def plot(study: Study, table: list[dict[str, Any]], out: Path) -> list[Path]:
         if bad:
             ax.plot(*zip(*bad, strict=True), "kx", ms=7, label="failed")
         chk = [(r[a.name], r[b.name], r) for r in rs if r.get("checked_2d")]
-        for x, y, r in chk:
-            ax.plot([x], [y], "o", ms=12, mfc="none", mec="red", mew=1.5)
+        for k, (x, y, r) in enumerate(chk):
+            ax.plot([x], [y], "o", ms=12, mfc="none", mec="red", mew=1.5,
+                    label=None if k else f"checked with the 2D model (beam − 2D error of {q})")
             e = _num(r.get(f"error_{q}"))
             if e is not None:
                 ax.annotate(f"{100 * e:+.0f}%", (x, y), xytext=(0, 9), textcoords="offset points",
                             ha="center", fontsize=7, color="red")
-        ax.set_xlabel(a.name)
-        ax.set_ylabel(b.name)
+        ax.set_xlim(X[0], X[-1])
+        ax.set_ylim(Y[0], Y[-1])
+        ax.set_xlabel(_axis_title(a))
+        ax.set_ylabel(_axis_title(b))
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="upper right")
         where = f", {rest[0].name} = {sl[0]}" if sl else ""
-        ax.set_title(f"{study.name}{where}: red circles = 2D-checked, beam-vs-2D error of {q}",
-                     fontsize=8)
+        ax.set_title(_wrapped(f"{study.name}{where}: {label}"), fontsize=9)
         fig.tight_layout()
-        path = out / (f"{study.name}-map.png" if not sl else f"{study.name}-map-{sl[0]}.png")
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        written.append(path)
+        written.append((f"{study.name}-map.png" if not sl else f"{study.name}-map-{sl[0]}.png",
+                        fig))
     return written
 
 
@@ -238,12 +252,37 @@ def _ref_value(study: Study, table: list[dict[str, Any]], row: dict[str, Any],
 
 
 def _edges(v):
+    """Cell edges around sorted axis values, bounded by the first and last value.
+
+    Inner edges halfway between values; the outer cells end at the axis's own first and last
+    values (half cells), so that no cell reaches a value the axis does not span.
+    """
     import numpy as np
 
     if len(v) == 1:
         return np.array([v[0] - 0.5, v[0] + 0.5])
-    mid = 0.5 * (v[1:] + v[:-1])
-    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+    return np.concatenate([[v[0]], 0.5 * (v[1:] + v[:-1]), [v[-1]]])
+
+
+def _axis_title(axis: Axis) -> str:
+    return axis_label(axis.name, axis.path, axis.derived, axis.scale)
+
+
+def _wrapped(title: str, width: int = 90) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(title, width))
+
+
+def _legend_of_checks(ax: Any, table: list[dict[str, Any]], q: str, *, two_d_marks: bool) -> None:
+    """Legend entries for the 2D-check markers, only where a case was checked."""
+    checked = [r for r in table if r.get("checked_2d")]
+    if not checked:
+        return
+    ax.plot([], [], "o", ms=11, mfc="none", mec="red", mew=1.5,
+            label=f"checked with the 2D model (beam − 2D error of {q})")
+    if two_d_marks and any(_num(r.get("2d_" + q)) is not None for r in checked):
+        ax.plot([], [], "x", color="red", ms=8, label="the 2D model's value")
 
 
 def _fmt(values: dict[str, Any]) -> str:
@@ -272,13 +311,16 @@ def summary(study: Study, table: list[dict[str, Any]], run_lines: list[str],
                "", f"Along {study.axes[0].name} (linear interpolation between the bracketing "
                "cases):", ""]
         others = [a.name for a in study.axes[1:]]
+        unit = f" ({UNITS[q]})" if q in UNITS else ""
         md.append("| " + " | ".join([*others, study.axes[0].name + " at the threshold",
-                                      f"{q} of the first case below it"]) + " |")
-        md.append("|" + "---|" * (len(others) + 2))
+                                      f"{q}{unit} of the first case below it",
+                                      "its first critical point"]) + " |")
+        md.append("|" + "---|" * (len(others) + 3))
         for c in cross:
             at = "not within the axis" if c["at"] is None else f"{c['at']:.3g}"
             md.append("| " + " | ".join([*(f"{c[o]:g}" if isinstance(c[o], float) else str(c[o])
-                                           for o in others), at, c["kind"]]) + " |")
+                                           for o in others), at, _g(c.get("value")),
+                                         c["kind"] or "—"]) + " |")
         md.append("")
     if checks:
         md += ["## 2D spot checks", "",

@@ -22,9 +22,11 @@ from pathlib import Path
 from typing import Any
 
 from sandwich.models import PROJECT_ROOT
+from sandwich.scene import Problem
 from sandwich.studies.study_case import reusable, solve_case
-from sandwich.studies.study_file import Case, Study
+from sandwich.studies.study_file import Case, Study, StudyError
 
+SCHEDULER_TIMEOUT = "10s"  # how long --scheduler's address may take to answer
 LINE_SECONDS = 30.0  # a non-terminal stream gets a progress line at least this often
 
 
@@ -106,7 +108,15 @@ def open_client(workers: int, scheduler: str | None):
     from distributed import Client, LocalCluster
 
     if scheduler:
-        client = Client(scheduler, timeout="30s")
+        try:
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            raise StudyError([Problem(
+                "command line", "--scheduler",
+                f"no Dask scheduler answered at {scheduler!r} within {SCHEDULER_TIMEOUT} "
+                f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); start one there "
+                "(`dask scheduler`, then `dask worker <address>` on each machine) or leave "
+                "--scheduler out to run on this machine's cores")]) from None
         return client, None, f"Dask cluster {scheduler} ({_threads(client)} worker threads)"
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            dashboard_address=None, silence_logs=40)

@@ -79,9 +79,10 @@ def make_solution(model: str, *, eps: float = 0.0, n_steps: int = 150, n_x: int 
         for name in drop:
             cols.pop(name)
         profiles.append(Profile(step=history[k].step, columns=cols))
-    i_max = int(np.argmax(lam))
-    limits = [LimitPoint("max", history[i_max].step, float(lam[i_max]),
-                         dict(history[i_max].probes))]
+    # every interior load maximum, as a model reports them (none on a path still rising)
+    peaks = [i for i in range(1, len(lam) - 1) if lam[i - 1] < lam[i] >= lam[i + 1]]
+    limits = [LimitPoint("max", history[i].step, float(lam[i]), dict(history[i].probes))
+              for i in peaks]
     return Solution(model=model, scene=scene, history=history, profiles=profiles,
                     converged=True, message="reached until probe", limit_points=limits,
                     wall_seconds=wall, dofs=dofs, extra={"level": "medium"})

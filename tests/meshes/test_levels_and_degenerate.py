@@ -7,7 +7,7 @@ import pytest
 
 from sandwich.meshes import build_mesh
 from sandwich.meshes.q9 import cell_areas
-from sandwich.scene import Debond, Load, Probe
+from sandwich.scene import Debond, Load, Probe, SceneError
 
 
 def _with(scene, **kw):
@@ -60,13 +60,14 @@ def test_close_stations_are_snapped_with_a_warning(fig5):
 
 def test_tiny_debond_refused(fig5):
     s = _with(fig5, debonds=(Debond("bottom", 100.0, 100.01),))
-    with pytest.raises(ValueError, match="shorter than"):
+    with pytest.raises(SceneError, match="shorter than") as info:  # bad input: file, key
         build_mesh(s, level="coarse")
+    assert [p.key for p in info.value.problems] == ["debonds[0]"]
 
 
 def test_debonds_closer_than_an_element_refused(fig5):
     s = _with(fig5, debonds=(Debond("top", 100.0, 120.0), Debond("top", 120.05, 125.0)))
-    with pytest.raises(ValueError, match="apart"):  # no snapping warning first
+    with pytest.raises(SceneError, match="apart"):  # no snapping warning first
         build_mesh(s, level="coarse")
 
 

@@ -208,3 +208,10 @@ def test_cli_refuses_bad_workers_and_an_output_path_that_is_a_file(tmp_path, cap
     assert main(["study", tiny, "--out", str(tmp_path / "file")]) == 2
     err = capsys.readouterr().err
     assert "Traceback" not in err and "file" in err
+
+
+def test_a_bad_key_in_the_study_tables_is_reported_once_not_per_case():
+    bad = HERE / "malformed" / "invalid-study-table.toml"
+    with pytest.raises(StudyError) as info:
+        load_study(bad)
+    assert [p.key for p in info.value.problems] == ["beam_model.elements"]
