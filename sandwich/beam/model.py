@@ -18,18 +18,10 @@ import scipy.sparse as sp
 from sandwich.beam.assembly import ReducedPattern, reduced_pattern, scatter_vector
 from sandwich.beam.constitutive import core_stiffness, face_stiffness
 from sandwich.beam.constraints import DofMap, NodeSupport, build_dof_map
-from sandwich.beam.contact import (
-    DEFAULT_REACH,
-    SHIFT,
-    ContactPairs,
-    compact_response,
-    contact_pair_groups,
-    contact_state,
-    forget_kinematics,
-    gap_change,
-    in_contact,
-    penalty_response,
-)
+from sandwich.beam.contact import compact_response, contact_state, gap_change, penalty_response
+from sandwich.beam.contact_law import SHIFT, in_contact
+from sandwich.beam.contact_projection import forget_kinematics
+from sandwich.beam.contact_search import DEFAULT_REACH, ContactPairs, contact_pair_groups
 from sandwich.beam.core_basis import CoreBasis, mode_dofs
 from sandwich.beam.dofs import ELEMENT_DOFS, NODE_DOFS
 from sandwich.beam.element import (

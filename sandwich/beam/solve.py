@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from sandwich.beam.contact import NORMAL_SIGN
+from sandwich.beam.contact_search import NORMAL_SIGN
 from sandwich.beam.core_levels import (
     DORFLER_FRACTION,
     LevelChoice,

@@ -445,14 +445,14 @@ def test_forget_evaluations_makes_the_next_evaluation_a_full_one(monkeypatch):
     ``forget_evaluations`` the closest-point kinematics are computed again (at the same u they
     are otherwise reused: a benchmark repeating one state would skip them), and the tangent
     is the same matrix (the cache only saves work)."""
-    from sandwich.beam import contact
+    from sandwich.beam import contact_projection
 
     scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
     model = build_model(scene, contact_search="closest-point")
     u = _contact_state(model, np.random.default_rng(5))
     calls = []
-    projected = contact._compact_kinematics
-    monkeypatch.setattr(contact, "_compact_kinematics",
+    projected = contact_projection.closest_point_kinematics
+    monkeypatch.setattr(contact_projection, "closest_point_kinematics",
                         lambda pairs, u_full: calls.append(1) or projected(pairs, u_full))
     K0 = model.tangent(u).copy()
     assert calls == [1]

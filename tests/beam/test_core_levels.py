@@ -357,7 +357,7 @@ def test_the_linear_step_of_a_long_debond_settles():
     from pathlib import Path
 
     from sandwich.beam import run
-    from sandwich.beam.contact import NORMAL_SIGN
+    from sandwich.beam.contact_search import NORMAL_SIGN
     from sandwich.beam.solve import _active_set_solution
     from sandwich.scene_file import load_scene
 
