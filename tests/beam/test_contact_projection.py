@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sandwich.beam import run
+from sandwich.beam import build_model, run
 from sandwich.beam.contact import pair_kinematics, penalty_response
 from sandwich.beam.contact_law import contact_energy
 from sandwich.beam.contact_projection import (
@@ -30,7 +30,6 @@ from sandwich.beam.contact_projection import (
 )
 from sandwich.beam.contact_search import NORMAL_SIGN, contact_pair_groups, contact_pairs
 from sandwich.beam.dofs import CONTACT_DOFS, NODE_DOFS, global_dof
-from sandwich.beam.model import build_model
 from sandwich.beam.shape_functions import x_shape
 from sandwich.scene_file import load_scene
 
