@@ -146,4 +146,3 @@ def contact_pair_groups(
         g = contact_pairs(interface, nodes[rows], x, width, search=search, reach=reach)
         groups.append(dataclasses.replace(g, parent=parent, parent_rows=rows))
     return groups
-

@@ -66,5 +66,3 @@ def core_groups(
         groups.append(CoreGroup(level=int(level), elements=els, op=op,
                                 products=geometric_products(op), dofs=ext_dofs[:, op.dofs]))
     return groups
-
-

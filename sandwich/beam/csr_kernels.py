@@ -220,4 +220,3 @@ def scatter_blocks(blocks, slots, signs, data):  # pragma: no cover - compiled
                 s = slots[e, a, b]
                 if s >= 0:
                     data[s] += signs[e, a, b] * blocks[e, a, b]
-

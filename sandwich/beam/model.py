@@ -82,10 +82,12 @@ class BeamModel:
     # full DOFs of each face's element family when the faces carry their stretch DOF
     face_dofs: dict | None = None
     committed: dict[str, ContactSummary] = field(default_factory=dict)
-    committed_u: np.ndarray | None = None  # the state whose contact ``committed`` summarises
     max_penetration_seen: float = 0.0
     max_sliding_seen: float = 0.0
-    last_evaluation: Evaluation | None = None
+    # the state whose contact ``committed`` summarises, and the last evaluation: not copied by
+    # dataclasses.replace (a model with other DOFs starts without them)
+    committed_u: np.ndarray | None = field(default=None, init=False, repr=False)
+    last_evaluation: Evaluation | None = field(default=None, init=False, repr=False)
     use_kernels = True  # class attribute, not a field: False forces the NumPy reference path
 
     def __post_init__(self) -> None:

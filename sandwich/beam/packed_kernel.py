@@ -226,4 +226,3 @@ def packed_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, 
             # every entry (physical: scaled) into the element's dense block, then out
             unpack_element(i, Kuu, Kww, Kuw, pu, pw, ucols, wcols, scale, Ke)
             emit_block(e0 + i, Ke, K_out, slots, signs, data)
-

@@ -90,8 +90,7 @@ def _untie(model, scene_, node):
                 for s in scene_.supports for f in s.faces]
     n = model.mesh.n_nodes  # the enrichment (core levels, face stretch) stays as it was
     active = (model.dof_map.free[NODE_DOFS * n:] >= 0).reshape(n, -1)
-    return dataclasses.replace(model, dof_map=build_dof_map(n, bonded, supports, active),
-                               last_evaluation=None)
+    return dataclasses.replace(model, dof_map=build_dof_map(n, bonded, supports, active))
 
 
 def _extension_release(elements):
