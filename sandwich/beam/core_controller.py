@@ -168,13 +168,9 @@ class CoreController:
         """The path at the chosen levels: the last pass, or the pass a stopped rerun checked."""
         a, choice = self.scene.analysis, self.choice
         while True:
-            budget = None if self.kept is None else min(
-                int(a.max_steps), max(self.settings.rerun_min_steps,
-                                      self.settings.rerun_step_factor
-                                      * (len(self.kept.path.states) - 1)))
             path = follow_penalised(self.scene, self.elements,
                                     {**self.options, "core_level": choice.levels},
-                                    self.progress, max_steps=budget)
+                                    self.progress, max_steps=self._rerun_budget())
             last = path.last
             if last.load_factor == 0.0:
                 return path
@@ -195,8 +191,8 @@ class CoreController:
             choice.passes.append(self._pass_entry(
                 path, reached=path.converged,
                 estimate=choice.estimate if self.previous is not None else None))
-            tol, top = float(self.scene.beam_model.tolerance), int(
-                self.scene.beam_model.max_core_level)
+            bm = self.scene.beam_model
+            tol, top = float(bm.tolerance), int(bm.max_core_level)
             if not path.converged or not np.any(choice.levels < top) or (
                     self.raises >= self.settings.rechecks) or (
                     choice.estimate is not None and self.previous is not None
@@ -231,6 +227,14 @@ class CoreController:
                     self.below_estimate = below
             if self.progress is not None:
                 self.progress(CoreRecheck(level_counts(choice.levels)))
+
+    def _rerun_budget(self) -> int | None:
+        """The steps a rerun may take: a multiple of the checked pass's (None: the first pass)."""
+        if self.kept is None:
+            return None
+        s = self.settings
+        return min(int(self.scene.analysis.max_steps),
+                   max(s.rerun_min_steps, s.rerun_step_factor * (len(self.kept.path.states) - 1)))
 
     def _pass_entry(self, path: PathPass, **entry: object) -> dict:
         """The passes' entry of a path at the current levels."""
