@@ -82,7 +82,7 @@ def _workload() -> None:
     if getattr(widened, "structure", narrow) is narrow:
         raise RuntimeError("build workload: the widening case did not widen")
     u_full = model.expand(np.full(model.size, 1e-3))
-    for op, _, els, dofs in model._families():
+    for op, _, els, dofs in model.element_families():
         K.layer_blocks(op, u_full[dofs], model.mesh.lengths[els], model.width)
 
 

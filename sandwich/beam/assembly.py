@@ -9,8 +9,10 @@ slot each local entry lands in and with which sign — is computed once; assembl
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from functools import cached_property
+from types import ModuleType
 
 import numpy as np
 import scipy.sparse as sp
@@ -34,6 +36,7 @@ class ReducedPattern:
     n: int
     free: tuple[np.ndarray, ...]  # per family: (B, n) reduced DOF (−1: eliminated), int64
     sign: tuple[np.ndarray, ...]  # per family: (B, n) sign of the reduced DOF (0: eliminated)
+    compiled: bool = True  # slot maps by the compiled kernels where numba is (else NumPy)
     _slots: dict = field(default_factory=dict, repr=False, compare=False)
 
     def slots_of(self, i: int) -> tuple[np.ndarray, np.ndarray]:
@@ -45,12 +48,12 @@ class ReducedPattern:
         if i not in self._slots:
             f = self.free[i]
             B, m = f.shape
-            kernels = _pattern_kernels()
+            kernels = compiled_kernels() if self.compiled else None
             if kernels is None:
                 slots = _slots_sorted(f, self.indptr, self.indices).astype(np.int32)
             else:  # written as int32 straight from the int32 pattern: no copies
                 slots = np.empty((B, m, m), dtype=np.int32)
-                kernels[1](f, self.indptr, self.indices, self.n, slots)
+                kernels.block_slots(f, self.indptr, self.indices, self.n, slots)
             sg = self.sign[i]
             self._slots[i] = (slots, sg[:, :, None] * sg[:, None, :])
         return self._slots[i]
@@ -98,14 +101,16 @@ def _slots_sorted(free: np.ndarray, indptr: np.ndarray, indices: np.ndarray) -> 
     return out.reshape(B, m, m)
 
 
-def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPattern:
+def reduced_pattern(
+    block_dofs: list[np.ndarray], dof_map: DofMap, compiled: bool = True
+) -> ReducedPattern:
     """Precompute the scatter of local blocks (full DOF index arrays ``(B, n)``) into Tᵀ K T.
 
     Compiled (:func:`sandwich.beam.kernels.block_pattern`: one pass over the blocks of each
-    row) where numba is, else by sorting every local entry's key; the slot maps per family on
-    demand (:meth:`ReducedPattern.slots_of`).
+    row) where numba is and ``compiled``, else by sorting every local entry's key; the slot maps
+    per family on demand (:meth:`ReducedPattern.slots_of`), by the same rule.
     """
-    kernels = _pattern_kernels()
+    kernels = compiled_kernels() if compiled else None
     n = dof_map.n_free
     free = [np.ascontiguousarray(dof_map.free[d], dtype=np.int64) for d in block_dofs]
     sign = [np.where(f >= 0, dof_map.sign[d], 0).astype(np.int8)
@@ -113,9 +118,9 @@ def reduced_pattern(block_dofs: list[np.ndarray], dof_map: DofMap) -> ReducedPat
     if kernels is None:
         indptr, indices = _pattern_sorted(free, n)
     else:
-        indptr, indices = _pattern_compiled(free, n, kernels[0])
+        indptr, indices = _pattern_compiled(free, n, kernels.block_pattern)
     return ReducedPattern(block_dofs=tuple(block_dofs), indices=indices, indptr=indptr, n=n,
-                          free=tuple(free), sign=tuple(sign))
+                          free=tuple(free), sign=tuple(sign), compiled=compiled)
 
 
 def _pattern_compiled(free: list[np.ndarray], n: int, block_pattern) -> tuple:
@@ -149,19 +154,14 @@ def _pattern_sorted(free: list[np.ndarray], n: int) -> tuple:
     return indptr, (unique % n).astype(np.int32)
 
 
-_PATTERN_KERNELS: list = []
-
-
-def _pattern_kernels():
-    """Compiled pattern builders (:mod:`sandwich.beam.kernels`), or None without numba."""
-    if not _PATTERN_KERNELS:
-        try:
-            from sandwich.beam.kernels import block_pattern, block_slots
-        except ImportError:
-            _PATTERN_KERNELS.append(None)
-        else:
-            _PATTERN_KERNELS.append((block_pattern, block_slots))
-    return _PATTERN_KERNELS[0]
+@functools.cache
+def compiled_kernels() -> ModuleType | None:
+    """:mod:`sandwich.beam.kernels` (imported on first use), or None without numba."""
+    try:
+        from sandwich.beam import kernels
+    except ImportError:
+        return None
+    return kernels
 
 
 def scatter_vector(

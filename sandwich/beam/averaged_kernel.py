@@ -18,7 +18,7 @@ kernel evaluates the same mechanics in one pass over elements × points:
 - tangent, geometric part (eq. 25): Σ_η dV σ̄_x P_xx is σ̄_x times the η-mean of the second
   variation of ε_x, i.e. the paper's pointwise term with σ̄_x (weights separable), as in NumPy.
 
-The arrays are those of :class:`sandwich.beam.kernels.KernelOperators` plus the normalised
+The arrays are those of :class:`sandwich.beam.packed_kernel.KernelOperators` plus the normalised
 η-weights; like the packed kernel, everything is generic in the layer's DOF count.
 """
 
@@ -69,9 +69,9 @@ def averaging_weights(op: LayerOperators) -> np.ndarray | None:
 def averaged_kernel(u_l, lengths, width, NuT, MwT, Nu, Mw, Quu, Qww, Quw, pu, pw, ucols, wcols,
                     x_slope, weight, wbar, C, thickness, f_out, want_k, K_out, slots, signs,
                     data):  # pragma: no cover - compiled
-    """:func:`sandwich.beam.kernels._kernel` with ε_x averaged along η (``wbar`` (n_η, n_ξ)).
+    """:func:`~sandwich.beam.packed_kernel.packed_kernel` with ε_x averaged along η by ``wbar``.
 
-    Points are ordered η slowest: g = j n_ξ + k for η index j and ξ index k.
+    ``wbar`` is (n_η, n_ξ). Points are ordered η slowest: g = j n_ξ + k for η index j and ξ index k.
     """
     E = u_l.shape[0]
     G = weight.size

@@ -1,13 +1,13 @@
 """Compiled closest-point contact kinematics: projection, gap, gradient and Hessian per pair.
 
-The same mechanics as the NumPy path of :mod:`sandwich.beam.contact` (its module docstring has
-the equations; ``_compact_kinematics_numpy`` there is the reference this kernel is tested
-against), in one loop over pairs with scalar work per candidate segment: the projection Newton
-φ(ξ) = r·X_ξ = 0 on every searched segment (each candidate stops on its own |Δξ| < tol, where
-the NumPy path iterates all of them until the slowest settles: the same ξ to round-off), the
-choice of the nearest projection on a segment (else the nearer end of the searched stretch),
-and on the chosen segment the gap g̃ = n·r with its derivatives in y = (ξ, q): J, Z, the
-implicit ξ_q = −φ_q/φ_ξ and
+The same mechanics as the NumPy path of :mod:`sandwich.beam.contact_projection` (its module
+docstring has the equations; ``closest_point_kinematics_numpy`` there is the reference this
+kernel is tested against), in one loop over pairs with scalar work per candidate segment: the
+projection Newton φ(ξ) = r·X_ξ = 0 on every searched segment (each candidate stops on its own
+|Δξ| < tol, where the NumPy path iterates all of them until the slowest settles: the same ξ to
+round-off), the choice of the nearest projection on a segment (else the nearer end of the
+searched stretch), and on the chosen segment the gap g̃ = n·r with its derivatives in
+y = (ξ, q): J, Z, the implicit ξ_q = −φ_q/φ_ξ and
 
     ∂g/∂q = g̃_q,    ∂²g/∂q² = g̃_qq + g̃_qξ ⊗ ξ_q + ξ_q ⊗ g̃_ξq + g̃_ξξ ξ_q ⊗ ξ_q.
 
@@ -115,7 +115,7 @@ def closest_point_kernel(x, values, core_nodes, xs, ws, x_node, valid, s_n, tol,
     is one pass over its window's boxes plus a projection per searched segment, and nothing is
     gathered per window (fig. 5 at 7680 elements: 4961 pairs × 250 segments).
     Returns gap (m,), grad (m, 10), hess (m, 10, 10), cols (m, 10), sliding, ξ, segment,
-    outside — the fields of ``sandwich.beam.contact._Compact``.
+    outside — the fields of ``sandwich.beam.contact_projection.ChosenSegment``.
     """
     m, S = valid.shape
     gap = np.empty(m)
@@ -293,9 +293,9 @@ def closest_point_kernel(x, values, core_nodes, xs, ws, x_node, valid, s_n, tol,
 def penalty_blocks(gap, grad, hess, area, penalty, smoothing, shift):  # pragma: no cover
     """Force −p A ∂g (m, n), tangent −A p'(g) ∂g ∂gᵀ − p A ∂²g (m, n, n) and pressure p (m,).
 
-    ``sandwich.beam.contact._penalty_blocks`` in one loop over pairs, with the shifted softplus
-    of ``sandwich.beam.contact.pressure_law`` (``shift`` = its c; ``smoothing`` 0: the plain
-    penalty ε ⟨−g⟩) evaluated per pair: no (m,)-sized temporaries, no (m, n, n) products.
+    ``sandwich.beam.contact_law.penalty_blocks`` in one loop over pairs, with the shifted
+    softplus of ``sandwich.beam.contact_law.pressure_law`` (``shift`` = its c; ``smoothing`` 0:
+    the plain penalty ε ⟨−g⟩) evaluated per pair: no (m,)-sized temporaries, no (m, n, n) products.
     """
     m, n = grad.shape
     f = np.empty((m, n))

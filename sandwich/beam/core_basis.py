@@ -12,7 +12,7 @@ are still the paper's DOFs: interface ties, contact (the core's outer boundary),
 are unchanged at every level, and level 1 is the paper's element exactly. The basis is
 hierarchical: level ℓ's functions are level ℓ−1's plus new ones, so a node of a lower level simply
 has the new amplitudes fixed at zero, and the level can change from element to element
-conformingly (:mod:`sandwich.beam.model`).
+conformingly (:mod:`sandwich.beam.core_groups`).
 
 Two families (``[beam_model] core_basis``):
 

@@ -15,10 +15,10 @@ raises the elements that carry the most of it (Dörfler marking) until the estim
 tolerance or every element is at the highest level allowed.
 
 The indicator is evaluated on the linear (small-displacement) step with unilateral contact,
-:func:`sandwich.beam.solve.linear_solution`. Along a nonlinear path the levels are re-checked on
-the last converged state: :func:`state_shares` says where (a residual indicator, no solve), and
-the path is rerun with those elements raised; the change of the end load between the two runs
-is the estimate (:func:`sandwich.beam.solve.run`).
+:func:`sandwich.beam.linear_step.linear_solution`. Along a nonlinear path the levels are
+re-checked on the last converged state: :func:`state_shares` says where (a residual indicator, no
+solve), and the path is rerun with those elements raised; the change of the end load between the
+two runs is the estimate (:mod:`sandwich.beam.core_controller`).
 """
 
 from __future__ import annotations
@@ -158,7 +158,7 @@ def state_shares(cur: BeamModel, u: np.ndarray, load_factor: float, up: BeamMode
     K⁻¹-based magnitude is meaningless there (a bordered Newton step from fig. 5's state at −5 mm
     gave 17 %, and Newton in the raised model from that state diverges), while the residual and
     the diagonal stay well defined. The *magnitude* of the error comes from rerunning the path
-    (:func:`sandwich.beam.solve.run`).
+    (:mod:`sandwich.beam.core_controller`).
     """
     v = transfer(u, cur, up)
     r = up.internal_force(v) - load_factor * up.f_ref

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sandwich.beam.contact import NORMAL_SIGN, contact_state, pressure_law
+from sandwich.beam.contact import contact_state
+from sandwich.beam.contact_law import pressure_law
+from sandwich.beam.contact_search import NORMAL_SIGN
 from sandwich.beam.kinematics import gradients, green_lagrange, linear_strains
 from sandwich.beam.model import BeamModel
 

@@ -174,10 +174,11 @@ def tip_releases(model: BeamModel, u: np.ndarray, tips: list[BeamTip],
         return []
     u_full = model.expand(u)
     counts = [closure_elements(model, t) if elements is None else elements for t in tips]
-    near = np.unique(np.concatenate([_closure_support(model, t, n)
+    near = np.unique(np.concatenate([closure_support(model, t, n)
                                      for t, n in zip(tips, counts, strict=True)]))
     f_full = model.full_response(u_full, tangent=False, elements=near)[0]
-    return [_closure(model, u_full, f_full, t, n) for t, n in zip(tips, counts, strict=True)]
+    return [closure_from_force(model, u_full, f_full, t, n)
+            for t, n in zip(tips, counts, strict=True)]
 
 
 def release_columns(model: BeamModel, u: np.ndarray, tips: list[BeamTip]
@@ -221,7 +222,7 @@ def closure_release(model: BeamModel, u: np.ndarray, t: BeamTip, elements: int) 
     """
     u_full = model.expand(u)
     f_full = model.full_response(u_full, tangent=False)[0]
-    return _closure(model, u_full, f_full, t, elements)
+    return closure_from_force(model, u_full, f_full, t, elements)
 
 
 def _tied(model: BeamModel, interface: str, node: int) -> bool:
@@ -255,8 +256,8 @@ def _ahead_nodes(model: BeamModel, t: BeamTip, delta: float) -> list[int]:
     return nodes
 
 
-def _closure_support(model: BeamModel, t: BeamTip, elements: int) -> np.ndarray:
-    """The elements whose layers' forces reach the tie reactions :func:`_closure` reads.
+def closure_support(model: BeamModel, t: BeamTip, elements: int) -> np.ndarray:
+    """The elements whose layers' forces reach the tie reactions :func:`closure_from_force` reads.
 
     Node k's DOFs belong to elements k − 1 and k only: the force there from these elements
     (and every contact pair) is the whole internal force (tested against the full one).
@@ -270,8 +271,12 @@ def _closure_support(model: BeamModel, t: BeamTip, elements: int) -> np.ndarray:
     return els[(els >= 0) & (els < model.mesh.n_elements)]
 
 
-def _closure(model: BeamModel, u_full: np.ndarray, f_full: np.ndarray, t: BeamTip,
-             elements: int) -> TipRelease:
+def closure_from_force(model: BeamModel, u_full: np.ndarray, f_full: np.ndarray, t: BeamTip,
+                       elements: int) -> TipRelease:
+    """:func:`closure_release` from the full DOF state ``u_full`` and internal force ``f_full``.
+
+    ``f_full`` need be exact only at the tie DOFs the closure reads (:func:`closure_support`).
+    """
     x = model.mesh.x
     behind_nodes = _behind_nodes(model, t, elements)
     if len(behind_nodes) < 2:

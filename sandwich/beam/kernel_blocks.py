@@ -1,10 +1,11 @@
 """Steps shared by the packed layer kernels (compiled): gather, per-point factors, unpack.
 
-:func:`sandwich.beam.kernels._kernel` and :func:`sandwich.beam.averaged_kernel.averaged_kernel`
-work on blocks of elements in the same layout: the layer's DOF values split into u and w
-columns (reference slopes: l/2 on x-slope DOFs), the force from the u and w row coefficients,
-and the tangent from packed uu / ww (upper triangles) and uw products. These helpers hold those
-steps once; each does exactly the arithmetic the kernels did inline (same operations, same order).
+:func:`sandwich.beam.packed_kernel.packed_kernel` and
+:func:`sandwich.beam.averaged_kernel.averaged_kernel` work on blocks of elements in the same
+layout: the layer's DOF values split into u and w columns (reference slopes: l/2 on x-slope
+DOFs), the force from the u and w row coefficients, and the tangent from packed uu / ww (upper
+triangles) and uw products. These helpers hold those steps once; each does exactly the
+arithmetic the kernels did inline (same operations, same order).
 """
 
 from __future__ import annotations

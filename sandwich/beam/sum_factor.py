@@ -239,7 +239,7 @@ def factored_flops(fo: FactoredOperators, tangent: bool = True) -> int:
     Gradients and force: per field and derivative, n_x n_z n_ξ + n_η n_ξ n_x multiply-adds.
     Tangent: the first stage's 12 GEMM columns per point (4 per pair, on the kept z-pairs) and
     the second stage, 4 n_η per (x-pair, z-pair) entry. Strains, stresses and H (O(1) per
-    point) and the scatter are left out, as in :func:`sandwich.beam.kernels.point_flops`.
+    point) and the scatter are left out, as in :func:`sandwich.beam.packed_kernel.point_flops`.
     """
     G = fo.n_eta * fo.n_xi
     f = 0
@@ -261,8 +261,8 @@ def factored_kernel(u_l, lengths, width, Xu, Xdu, ZuT, ZduT, iu, ju, Xw, Xdw, Zw
                     data):  # pragma: no cover - compiled
     """Force into ``f_out`` (E, n); tangent into ``K_out`` (E, n, n) or ``data[slots]``.
 
-    The same arguments and outputs as :func:`sandwich.beam.kernels._kernel`, with the rows given
-    by their factors (:class:`FactoredOperators`; z-functions transposed, (n_z, n_ξ)).
+    The same arguments and outputs as :func:`sandwich.beam.packed_kernel.packed_kernel`, with the
+    rows given by their factors (:class:`FactoredOperators`; z-functions transposed, (n_z, n_ξ)).
     """
     E = u_l.shape[0]
     Gx = Xu.shape[0]

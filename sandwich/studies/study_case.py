@@ -82,10 +82,10 @@ def linear_indicator(scene: Scene) -> float | None:
     The relative change of the linear stiffness when every core level is raised by
     :data:`LOOKAHEAD` (the saturation estimate the ``"auto"`` core uses,
     :mod:`sandwich.beam.core_levels`), on the small-displacement step: of the until probe's
-    response, else of the compliance (:func:`sandwich.beam.solve.linear_responses`; the two
+    response, else of the compliance (:func:`sandwich.beam.core_choice.linear_responses`; the two
     solves, the second started from the first one's contact set, are all it computes).
     """
-    from sandwich.beam.solve import linear_responses  # (the beam's kernels: when needed)
+    from sandwich.beam.core_choice import linear_responses  # (the beam's kernels: when needed)
 
     level = scene.beam_model.core
     raised = min(level + LOOKAHEAD, MAX_CORE_LEVEL) if isinstance(level, int) else None

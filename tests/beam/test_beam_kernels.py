@@ -18,10 +18,10 @@ import pytest
 import scipy.sparse as sp
 from beam_scenes import KEVLAR, ROHACELL, Debond, sandwich_scene  # noqa: I001
 
-from sandwich.beam import element, kernels
+from sandwich.beam import build_model, element, kernels
 from sandwich.beam.constitutive import core_stiffness, face_stiffness
+from sandwich.beam.factorisation import embed_in_pattern
 from sandwich.beam.layer_operators import build_face_operators, build_layer_operators
-from sandwich.beam.model import build_model
 from sandwich.beam.quadrature import EXACT_ORDER
 from sandwich.solver.envelope import EnvelopeFactorization
 from sandwich.solver.sparse import SparseFactorization
@@ -214,7 +214,7 @@ def test_model_compiled_path_matches_numpy_path(options):
     model.use_kernels = False
     f0, K0 = model.internal_force(u), model.tangent(u)
     model.use_kernels = True
-    model._cache = None
+    model.forget_evaluations(contact_kinematics=False)
     f1, K1 = model.internal_force(u), model.tangent(u)
     assert np.linalg.norm(f1 - f0) <= 1e-13 * np.linalg.norm(f0)
     assert abs(K1 - K0).max() <= 1e-13 * abs(K0).max()
@@ -245,7 +245,7 @@ def test_compiled_pattern_grows_to_the_segments_projections_meet():
     slide = 2.5 * np.diff(x).min() * np.ones(pairs.size)  # ≥ 2 segments for every pair
     u[free[pairs.dofs[:, 0]]] += slide
     before = model.pattern.indices.size
-    model._cache = None
+    model.forget_evaluations(contact_kinematics=False)
     f1, K1 = model.internal_force(u), model.tangent(u)
     assert model.pattern_growths >= 1 and model.pattern.indices.size > before
     k = model.contact_summary(u)["top"]
@@ -256,7 +256,7 @@ def test_compiled_pattern_grows_to_the_segments_projections_meet():
     assert np.linalg.norm(f1 - f0) <= 1e-13 * np.linalg.norm(f0)
     assert abs(K1 - K0).max() <= 1e-13 * abs(K0).max()
     grown = model.pattern_growths
-    model._cache = None
+    model.forget_evaluations(contact_kinematics=False)
     model.internal_force(u + 1e-9)  # the same segments: no growth
     assert model.pattern_growths == grown
 
@@ -275,7 +275,7 @@ def test_pattern_growth_takes_the_neighbouring_segments():
     for slide, growths in ((1.2 * h, 1), (2.2 * h, 1)):
         v = u.copy()
         v[face_u] += slide
-        model._cache = None
+        model.forget_evaluations(contact_kinematics=False)
         f1, K1 = model.internal_force(v), model.tangent(v)
         assert model.pattern_growths == growths
         assert model.contact_summary(v)["top"].active > 0
@@ -291,7 +291,7 @@ def test_compiled_force_carries_its_tangent():
     model = build_model(sandwich_scene(length=60.0, elements=8))
     u = np.random.default_rng(0).normal(size=model.size) * 1e-3
     model.internal_force(u)
-    K = model._cache[2]
+    K = model.last_evaluation.tangent
     assert K is not None and model.tangent(u) is K
     assert model.residual_roundoff(u) > 0 and model.tangent(u) is K
     # ε ‖ |K| |u| ‖ as scipy forms it (the compiled row sums take the same order)
@@ -305,7 +305,7 @@ def test_contact_summary_reuses_the_evaluation_and_agrees():
     u = _contact_state(model, np.random.default_rng(4))
     fresh = model.contact_summary(u)  # nothing evaluated yet at u
     model.internal_force(u)
-    assert model._cache[3].contact  # kept by the evaluation
+    assert model.last_evaluation.assembled.contact  # kept by the evaluation
     assert model.contact_summary(u) == fresh
     assert fresh["top"].active > 0
 
@@ -364,20 +364,20 @@ def test_a_matrix_inside_the_model_pattern_reuses_its_factorisation_structure():
     model.factorize(K)
     sub = sp.csr_matrix(K.toarray() * (np.random.default_rng(0).random(K.shape) < 0.5))
     sub = sub + sub.T + sp.diags(K.diagonal())  # symmetric, fewer non-zeros than K
-    on = model._on_pattern(sub.tocsr())
+    on = embed_in_pattern(sub.tocsr(), model.pattern)
     assert on is not None and on.nnz == K.nnz
     assert np.array_equal(on.toarray(), sub.toarray())
     fac = model.factorize(sub.tocsr())
-    assert len(model._envelopes) == 1  # no new symbolic factorisation
+    assert len(model.factorisations.structures) == 1  # no new symbolic factorisation
     b = np.ones(model.size)
     assert np.allclose(sub @ fac.solve(b), b, rtol=0, atol=1e-8 * np.abs(b).max())
     outside = sp.csr_matrix(K + sp.eye(model.size, k=model.size - 1) + sp.eye(model.size,
                                                                               k=1 - model.size))
-    assert model._on_pattern(outside.tocsr()) is None
+    assert embed_in_pattern(outside.tocsr(), model.pattern) is None
 
 
 @pytest.mark.parametrize("options", [{}, {"core_level": 2}, {"contact_search": "closest-point"}])
-def test_reduced_pattern_is_the_same_with_and_without_the_compiled_builder(options, monkeypatch):
+def test_reduced_pattern_is_the_same_with_and_without_the_compiled_builder(options):
     """The compiled pattern builder against the sort of every local entry's key (np.unique),
     and both against the scipy COO → CSR pattern of Tᵀ K T's entries."""
     from sandwich.beam import assembly
@@ -386,8 +386,7 @@ def test_reduced_pattern_is_the_same_with_and_without_the_compiled_builder(optio
                            debonds=(Debond("top", 15.0, 45.0), Debond("bottom", 0.0, 20.0)))
     model = build_model(scene, **options)
     fast = assembly.reduced_pattern(model.block_dofs, model.dof_map)
-    monkeypatch.setattr(assembly, "_PATTERN_KERNELS", [None])  # the np.unique path
-    slow = assembly.reduced_pattern(model.block_dofs, model.dof_map)
+    slow = assembly.reduced_pattern(model.block_dofs, model.dof_map, compiled=False)  # np.unique
     for key in ("slot", "keep", "weight", "indices", "indptr"):
         a, b = getattr(fast, key), getattr(slow, key)
         assert a.dtype == b.dtype and np.array_equal(a, b), key
@@ -445,18 +444,18 @@ def test_forget_evaluations_makes_the_next_evaluation_a_full_one(monkeypatch):
     ``forget_evaluations`` the closest-point kinematics are computed again (at the same u they
     are otherwise reused: a benchmark repeating one state would skip them), and the tangent
     is the same matrix (the cache only saves work)."""
-    from sandwich.beam import contact
+    from sandwich.beam import contact_projection
 
     scene = sandwich_scene(length=60.0, elements=16, debonds=(Debond("top", 15.0, 45.0),))
     model = build_model(scene, contact_search="closest-point")
     u = _contact_state(model, np.random.default_rng(5))
     calls = []
-    projected = contact._compact_kinematics
-    monkeypatch.setattr(contact, "_compact_kinematics",
+    projected = contact_projection.closest_point_kinematics
+    monkeypatch.setattr(contact_projection, "closest_point_kinematics",
                         lambda pairs, u_full: calls.append(1) or projected(pairs, u_full))
     K0 = model.tangent(u).copy()
     assert calls == [1]
-    model._cache = None  # the model's own cache alone: the kinematics are still reused
+    model.forget_evaluations(contact_kinematics=False)  # the kinematics are still reused
     model.tangent(u)
     assert calls == [1]
     model.forget_evaluations()

@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 from beam_scenes import KEVLAR, ROHACELL, Debond, assert_layer_derivatives, sandwich_scene  # noqa: I001
 
+from sandwich.beam import build_model
 from sandwich.beam.constitutive import core_stiffness, face_stiffness
-from sandwich.beam.contact import contact_pairs, pair_kinematics, penalty_response
+from sandwich.beam.contact import pair_kinematics, penalty_response
+from sandwich.beam.contact_search import contact_pairs
 from sandwich.beam.dofs import global_dof
 from sandwich.beam.layer_operators import build_layer_operators
-from sandwich.beam.model import build_model
 from sandwich.beam.quadrature import EXACT_ORDER
 
 LAYER_CASES = [("top", 0.5, face_stiffness(KEVLAR)), ("core", 25.0, core_stiffness(ROHACELL)),

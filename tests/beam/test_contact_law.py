@@ -1,4 +1,4 @@
-"""The regularised (shifted softplus) contact law of sandwich.beam.contact.
+"""The regularised (shifted softplus) contact law of sandwich.beam.contact_law.
 
 References: the closed-form energy (dilogarithm) differentiated by central finite differences; the
 law's own definition for the limits (p = 0 for g ≥ 0, p → ε(−g − c s) deep in contact).
@@ -6,14 +6,16 @@ law's own definition for the limits (p = 0 for g ≥ 0, p → ε(−g − c s) d
 
 import numpy as np
 
-from sandwich.beam.contact import (
+from sandwich.beam.contact import pair_kinematics, penalty_response
+from sandwich.beam.contact_law import (
     SHIFT,
     contact_energy,
-    contact_pairs,
-    pair_kinematics,
-    penalty_response,
+    penalty_blocks,
+    penalty_blocks_numpy,
+    penalty_kernel,
     pressure_law,
 )
+from sandwich.beam.contact_search import contact_pairs
 
 EPS = 2.24e4  # N/mm³, the default penalty for the paper's Rohacell core
 S = 1e-6  # mm, the default regularisation width for 0.5 mm faces
@@ -75,9 +77,7 @@ def test_compiled_penalty_blocks_are_the_numpy_law_to_round_off():
     """The compiled blocks (contact_kernel.penalty_blocks) against the NumPy reference
     (pressure_law, then the outer products): open, in the softplus knee, deep, and the plain
     penalty (s = 0); relative round-off of each block's largest entry."""
-    from sandwich.beam import contact
-
-    kernel = contact._penalty_kernel()
+    kernel = penalty_kernel()
     if kernel is None:
         import pytest
 
@@ -90,8 +90,8 @@ def test_compiled_penalty_blocks_are_the_numpy_law_to_round_off():
     hess = hess + hess.transpose(0, 2, 1)
     area = rng.uniform(1.0, 3.0, m)
     for smoothing in (S, 0.0):
-        f, K, p = contact._penalty_blocks(gap, grad, hess, area, EPS, smoothing)
-        f0, K0, p0 = contact._penalty_blocks_numpy(gap, grad, hess, area, EPS, smoothing)
+        f, K, p = penalty_blocks(gap, grad, hess, area, EPS, smoothing)
+        f0, K0, p0 = penalty_blocks_numpy(gap, grad, hess, area, EPS, smoothing)
         assert np.all(p[:2] == 0) and np.all(f[:2] == 0) and np.all(K[:2] == 0)  # open
         scale = np.abs(K0).max(axis=(1, 2))[:, None, None] + 1e-300
         assert np.allclose(p, p0, rtol=1e-13, atol=0)

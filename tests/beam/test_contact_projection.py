@@ -1,9 +1,9 @@
-"""Closest-point (node-to-segment) contact of sandwich.beam.contact (issue #3).
+"""Closest-point (node-to-segment) contact of sandwich.beam.contact_projection (issue #3).
 
 References, test by test:
 
 - the core boundary curve is rebuilt here from the element's own x shape functions
-  (``sandwich.beam.shape_functions.x_shape``, eq. 11a), not from ``contact.hermite_basis``;
+  (``sandwich.beam.shape_functions.x_shape``, eq. 11a), not from ``hermite_basis``;
 - known closest points: a face node is put at X(s) + g n(s), n the curve's deformed outward normal
   at a chosen material point s; r = g n is normal to the curve there, so the exact gap is g and
   the exact (material) sliding s − x_i;
@@ -19,18 +19,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sandwich.beam import run
-from sandwich.beam.contact import (
-    NORMAL_SIGN,
-    contact_energy,
-    contact_pair_groups,
-    contact_pairs,
+from sandwich.beam import build_model, run
+from sandwich.beam.contact import pair_kinematics, penalty_response
+from sandwich.beam.contact_law import contact_energy
+from sandwich.beam.contact_projection import (
+    closest_point_kernel,
+    closest_point_kinematics,
+    closest_point_kinematics_numpy,
     hermite_basis,
-    pair_kinematics,
-    penalty_response,
 )
+from sandwich.beam.contact_search import NORMAL_SIGN, contact_pair_groups, contact_pairs
 from sandwich.beam.dofs import CONTACT_DOFS, NODE_DOFS, global_dof
-from sandwich.beam.model import build_model
 from sandwich.beam.shape_functions import x_shape
 from sandwich.scene_file import load_scene
 
@@ -417,12 +416,10 @@ def test_consistent_tangent_beyond_the_searched_segments(interface):
 
 @pytest.mark.parametrize("interface", ["top", "bottom"])
 def test_compiled_kinematics_match_the_numpy_reference(interface):
-    """sandwich.beam.contact_kernel against contact._compact_kinematics_numpy (the equations
+    """sandwich.beam.contact_kernel against closest_point_kinematics_numpy (the equations
     written array-wise): rotated wavy core, slidings inside and beyond the reach, open and
     closed pairs; the same segment, ξ and outside flags, gap and derivatives to round-off."""
-    from sandwich.beam import contact
-
-    if contact._closest_point_kernel() is None:
+    if closest_point_kernel() is None:
         pytest.skip("numba not installed: the NumPy path is the only one")
     rng = np.random.default_rng(11)
     nodes = np.arange(1, XU.size - 1)
@@ -431,8 +428,8 @@ def test_compiled_kinematics_match_the_numpy_reference(interface):
         slide = rng.uniform(-1.5, 1.5, nodes.size) * (0.3 + trial / 3)
         gaps = rng.uniform(-0.05, 0.05, nodes.size)
         u = _state(interface, slide, gaps, theta=0.1 * trial, x=XU, nodes=nodes)
-        a = contact._compact_kinematics(pairs, u)
-        b = contact._compact_kinematics_numpy(pairs, u)
+        a = closest_point_kinematics(pairs, u)
+        b = closest_point_kinematics_numpy(pairs, u)
         assert b.outside.any() or trial < 2
         np.testing.assert_array_equal(a.segment, b.segment)
         np.testing.assert_array_equal(a.outside, b.outside)
@@ -452,9 +449,7 @@ def test_compiled_search_breaks_ties_as_the_exhaustive_one(interface):
     shared node of two segments (ξ = 1 on the left one, ξ = 0 on the right one, the same
     distance): both must pick the left (lower) segment, for open pairs at several heights and
     for a face slid by whole elements onto other nodes."""
-    from sandwich.beam import contact
-
-    if contact._closest_point_kernel() is None:
+    if closest_point_kernel() is None:
         pytest.skip("numba not installed: the NumPy path is the only one")
     nodes = np.arange(1, XU.size - 1)
     pairs = contact_pairs(interface, nodes, XU, 60.0, search="closest-point", reach=1.0)
@@ -465,8 +460,8 @@ def test_compiled_search_breaks_ties_as_the_exhaustive_one(interface):
         target = np.clip(nodes + shift, 0, XU.size - 1)  # onto another core node
         u[global_dof(nodes, names["u_face"])] = XU[target] - XU[nodes]
         u[global_dof(nodes, names["w_face"])] = side * lift
-        a = contact._compact_kinematics(pairs, u)
-        b = contact._compact_kinematics_numpy(pairs, u)
+        a = closest_point_kinematics(pairs, u)
+        b = closest_point_kinematics_numpy(pairs, u)
         inner = (target > 0) & (target < XU.size - 1)
         assert np.all(np.isin(a.xi[inner], (0.0, 1.0)))  # on a shared node: a tie
         np.testing.assert_array_equal(a.segment, b.segment)

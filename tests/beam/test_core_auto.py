@@ -8,16 +8,15 @@ and the scene's mirror symmetry.
 from __future__ import annotations
 
 import dataclasses
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from beam_scenes import sandwich_scene
 
-from sandwich.beam import run
+from sandwich.beam import build_model, run
+from sandwich.beam.core_controller import AutoSettings
 from sandwich.beam.core_levels import level_counts
-from sandwich.beam.model import build_model
 from sandwich.beam.solve import linear_solution
 from sandwich.scene import Analysis, CoreZone
 from sandwich.scene_file import load_scene
@@ -95,14 +94,13 @@ def test_zones_raise_the_levels_and_auto_keeps_them_as_a_floor():
     assert np.all(run(auto).model.element_levels[inside] >= 4)
 
 
-def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them(monkeypatch):
+def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
     """Nonlinear bend to −6 mm: the linear step's choice is re-checked at the end of the path;
     a tight tolerance makes it rerun with more levels, and the final estimate is reported.
     (Its raise changes the end load by 0.04 %, under a quarter of the tolerance, which would
     report the checked path itself — test_core_end_state.py; switched off here: the rerun.)"""
-    monkeypatch.setattr(sys.modules["sandwich.beam.solve"], "BELOW_FRACTION", 0.0)
     scene = _bend_to_6mm(tolerance=0.003, max_core_level=4)
-    r = run(scene)
+    r = run(scene, auto=AutoSettings(below_fraction=0.0))
     core = r.solution.extra["core"]
     stages = [p["stage"] for p in core["passes"]]
     assert sum(s.startswith("path step") for s in stages) >= 2, stages  # rerun at least once
@@ -110,16 +108,13 @@ def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them(mon
     assert core["estimated_error"] <= 0.003 or "WARNING" in r.solution.message
 
 
-def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking(monkeypatch):
+def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking():
     """The rerun's step budget (a multiple of the checked pass's steps) cut to 2 steps: the
     raised path cannot reach −6 mm, so the answer is the first path pass (its levels, its end
     load) with a WARNING, and the stopped rerun is listed in the passes."""
-    solve = sys.modules["sandwich.beam.solve"]  # the module (the package exports a function)
-    monkeypatch.setattr(solve, "BELOW_FRACTION", 0.0)  # a rerun, not the checked path (above)
-    monkeypatch.setattr(solve, "RERUN_STEP_FACTOR", 0)
-    monkeypatch.setattr(solve, "RERUN_MIN_STEPS", 2)
     scene = _bend_to_6mm(tolerance=0.003, max_core_level=4)
-    r = run(scene)
+    # below_fraction 0: a rerun, not the checked path (above)
+    r = run(scene, auto=AutoSettings(below_fraction=0.0, rerun_step_factor=0, rerun_min_steps=2))
     sol, core = r.solution, r.solution.extra["core"]
     paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
     first, rerun = paths[0], paths[-1]
@@ -164,6 +159,7 @@ def test_auto_reruns_stop_where_the_path_comes_back_through_zero_load(monkeypatc
     a first pass without (fig. 5's scene with a 45-mm debond at x = 70: a level-3 rerun went on
     to λ = −2447 for 156 steps before; docs/solver.md)."""
     import sandwich.solver.path as path_module
+    from sandwich.beam import path_pass
 
     seen = []
     real = path_module.follow_path
@@ -173,9 +169,8 @@ def test_auto_reruns_stop_where_the_path_comes_back_through_zero_load(monkeypatc
         return real(system, options, *args, **kwargs)
 
     monkeypatch.setattr(path_module, "follow_path", spy)
-    solve = sys.modules["sandwich.beam.solve"]
     scene = _bend_to_6mm()
     model = build_model(scene, core_level=1)
-    solve._follow(model, scene, None)
-    solve._follow(model, scene, None, max_steps=3)
+    path_pass.follow(model, scene, None)
+    path_pass.follow(model, scene, None, max_steps=3)
     assert seen == [False, True]

@@ -1,18 +1,17 @@
 """``auto`` core levels: a raise is first tried on the checked pass's end state alone.
 
 The reference is the path itself: the same scene with the end-state checks switched off
-(``solve.END_STATE_CHECKS = False``) follows the whole path again after every raise (the scheme
-before them). Where a continued end state is where the path at its levels ends, both choose the
-same levels and report the same end load and estimate, and the checks save the intermediate
+(``AutoSettings(end_state_checks=False)``) follows the whole path again after every raise (the
+scheme before them). Where a continued end state is where the path at its levels ends, both choose
+the same levels and report the same end load and estimate, and the checks save the intermediate
 paths; where it is not (another equilibrium at the same deflection), the pass that follows the
-checks says so and the run goes back to following the path after every raise, so the answer
-is again the reruns' one.
+checks says so and the run goes back to following the path after every raise, so the answer is
+again the reruns' one.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -20,11 +19,16 @@ import pytest
 from beam_scenes import sandwich_scene
 
 from sandwich.beam import run
+from sandwich.beam.core_controller import (
+    BELOW_FACTOR,
+    BELOW_FRACTION,
+    AutoSettings,
+    CoreController,
+)
 from sandwich.beam.core_levels import level_counts
 from sandwich.scene import Analysis
 from sandwich.scene_file import load_scene
 
-solve = sys.modules["sandwich.beam.solve"]  # the module (the package exports a function)
 C1 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig7-cantilever-c1.toml"
 
 
@@ -34,17 +38,11 @@ def _stages(r, prefix):
 
 def _both(elements):
     """c1 with the checks, and with the reruns after every raise; neither reports the levels
-    below a check within half the tolerance (BELOW_FRACTION = 0: that is compared below)."""
+    below a check within half the tolerance (``below_fraction`` 0: that is compared below)."""
     scene = load_scene(C1)
-    below = solve.BELOW_FRACTION
-    solve.BELOW_FRACTION = 0.0
-    try:
-        checked = run(scene, elements=elements)
-        solve.END_STATE_CHECKS = False
-        rerun = run(scene, elements=elements)
-    finally:
-        solve.END_STATE_CHECKS = True
-        solve.BELOW_FRACTION = below
+    checked = run(scene, elements=elements, auto=AutoSettings(below_fraction=0.0))
+    rerun = run(scene, elements=elements,
+                auto=AutoSettings(below_fraction=0.0, end_state_checks=False))
     return checked, rerun
 
 
@@ -108,7 +106,7 @@ def test_a_failed_end_state_falls_back_to_following_the_path(monkeypatch, confir
     """No check converges: the reruns' passes exactly, and no check tried after the first."""
     _, rerun = confirmed
     calls = []
-    monkeypatch.setattr(solve, "_end_state", lambda *args: calls.append(args) or None)
+    monkeypatch.setattr(CoreController, "end_state", lambda *args: calls.append(args) or None)
     r = run(load_scene(C1))
     assert len(calls) == 1
     assert not _stages(r, "end state")
@@ -140,7 +138,7 @@ def _bend(tolerance, core="auto"):
         scene.beam_model, tolerance=tolerance, max_core_level=4, core=core))
 
 
-def test_a_first_check_far_within_the_tolerance_reports_the_path_it_checked(monkeypatch):
+def test_a_first_check_far_within_the_tolerance_reports_the_path_it_checked():
     """Tolerance 0.3 %: the first check on the path's end state changes the end load by
     δ = 0.04 % ≤ tolerance / 4; the path it checked is the answer (one path, not two), with the
     estimate 2δ. Against the uniform level-5 answer of the same mesh (the hierarchy's converged
@@ -152,8 +150,8 @@ def test_a_first_check_far_within_the_tolerance_reports_the_path_it_checked(monk
     paths, ends = _stages(r, "path step"), _stages(r, "end state")
     assert len(paths) == 1 and len(ends) == 1, core["passes"]
     delta = ends[0]["estimate"]
-    assert ends[0]["levels_below_reported"] is True and delta <= solve.BELOW_FRACTION * 0.003
-    assert core["estimated_error"] == pytest.approx(solve.BELOW_FACTOR * delta, rel=1e-12)
+    assert ends[0]["levels_below_reported"] is True and delta <= BELOW_FRACTION * 0.003
+    assert core["estimated_error"] == pytest.approx(BELOW_FACTOR * delta, rel=1e-12)
     assert r.solution.final_load_factor == paths[0]["load_factor"]
     assert level_counts(r.model.element_levels) == paths[0]["elements_per_level"]
     assert "WARNING" not in r.solution.message
@@ -162,13 +160,12 @@ def test_a_first_check_far_within_the_tolerance_reports_the_path_it_checked(monk
     true = abs(r.solution.final_load_factor / limit.solution.final_load_factor - 1)
     assert true <= 1.5 * 0.003, true
     # without the rule the raised path is followed, and it ends where the check said
-    monkeypatch.setattr(solve, "BELOW_FRACTION", 0.0)
-    raised = run(_bend(0.003))
+    raised = run(_bend(0.003), auto=AutoSettings(below_fraction=0.0))
     assert len(_stages(raised, "path step")) == 2
     assert raised.solution.final_load_factor == pytest.approx(ends[0]["load_factor"], rel=1e-6)
 
 
-def test_a_later_check_far_within_the_tolerance_has_the_path_followed_below_it(monkeypatch):
+def test_a_later_check_far_within_the_tolerance_has_the_path_followed_below_it():
     """The default scene at 120 elements: the first check changes the end load by 1.1 % (above
     the 1 % tolerance), the second, from it, by 0.15 % ≤ tolerance / 4. The path is followed at
     the first check's levels (not the second's), must end at its load, and is the answer with the
@@ -180,13 +177,12 @@ def test_a_later_check_far_within_the_tolerance_has_the_path_followed_below_it(m
     assert len(paths) == 2 and len(ends) == 2, core["passes"]
     assert ends[0]["estimate"] > 0.01 and "levels_below_reported" not in ends[0]
     assert ends[1]["levels_below_reported"] is True
-    assert ends[1]["estimate"] <= solve.BELOW_FRACTION * 0.01
+    assert ends[1]["estimate"] <= BELOW_FRACTION * 0.01
     assert paths[-1]["elements_per_level"] == ends[0]["elements_per_level"]
     assert level_counts(r.model.element_levels) == ends[0]["elements_per_level"]
     assert r.solution.final_load_factor == pytest.approx(ends[0]["load_factor"], rel=1e-6)
-    assert core["estimated_error"] == pytest.approx(solve.BELOW_FACTOR * ends[1]["estimate"],
+    assert core["estimated_error"] == pytest.approx(BELOW_FACTOR * ends[1]["estimate"],
                                                     rel=1e-12)
-    monkeypatch.setattr(solve, "BELOW_FRACTION", 0.0)
-    raised = run(scene, elements=120)
+    raised = run(scene, elements=120, auto=AutoSettings(below_fraction=0.0))
     assert level_counts(raised.model.element_levels) == ends[1]["elements_per_level"]
     assert raised.solution.final_load_factor == pytest.approx(ends[1]["load_factor"], rel=1e-6)

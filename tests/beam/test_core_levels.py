@@ -8,17 +8,16 @@ differences of the internal force, and the nested-space identity of Galerkin sol
 from __future__ import annotations
 
 import dataclasses
-import sys
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 from beam_scenes import sandwich_scene as three_point_bend
 
+from sandwich.beam import build_model
 from sandwich.beam.core_basis import MAX_LEVEL, CoreBasis
 from sandwich.beam.core_levels import transfer
 from sandwich.beam.dofs import NODE_DOFS
-from sandwich.beam.model import build_model
 from sandwich.beam.shape_functions import x_shape, z_shape
 from sandwich.beam.solve import linear_solution
 from sandwich.scene import Analysis, Debond
@@ -214,44 +213,44 @@ def test_linear_active_set_from_another_start_ends_at_the_same_fixed_point():
     iteration has one fixed point whatever it starts from: every pair open (the default),
     every pair closed, or another level's settled set (what the auto levels hand on) give the
     same set and the same solution, the last in one pass."""
-    from sandwich.beam.solve import _active_set_solution
+    from sandwich.beam.linear_step import active_set_solution
 
     scene = _debonded_bend()
     m1 = build_model(scene, elements=24, core_level=1)
     m3 = build_model(scene, elements=24, core_level=3)
-    _, _, settled_1 = _active_set_solution(m1, 1.0)
-    u3, passes_3, settled_3 = _active_set_solution(m3, 1.0)
+    _, _, settled_1 = active_set_solution(m1, 1.0)
+    u3, passes_3, settled_3 = active_set_solution(m3, 1.0)
     closed = int(settled_3[0].sum())
     assert passes_3 >= 3 and 0 < closed < settled_3[0].size  # a real active-set problem
     for start in (settled_1, [np.ones_like(a) for a in settled_3]):
-        u, passes, settled = _active_set_solution(m3, 1.0, start)
+        u, passes, settled = active_set_solution(m3, 1.0, start)
         assert all(np.array_equal(a, b) for a, b in zip(settled, settled_3, strict=True))
         assert np.linalg.norm(u - u3) <= 1e-14 * np.linalg.norm(u3)
         assert passes < passes_3
-    assert _active_set_solution(m3, 1.0, settled_1)[1] == 1
+    assert active_set_solution(m3, 1.0, settled_1).passes == 1
 
 
 def test_the_level_choice_solves_each_model_once(monkeypatch):
     """Nothing computed twice: the floor's linear step that finds the load's sign (an until
     probe) is the level choice's first solve, and each model of the choice is solved once —
     and the choice is the one made with every solve done afresh (each from every pair open)."""
-    from sandwich.beam.solve import choose_core_levels, scene_model_options
-
-    solve_module = sys.modules["sandwich.beam.solve"]  # the module (the package exports a function)
+    from sandwich.beam import linear_step
+    from sandwich.beam.core_choice import choose_core_levels
+    from sandwich.beam.solve import scene_model_options
 
     base = _debonded_bend()
     scene = dataclasses.replace(base, beam_model=dataclasses.replace(
         base.beam_model, core="auto", elements=24), analysis=Analysis(
         kind="nonlinear", until_probe="w_top_mid", until_value=-4.0))
     options = scene_model_options(scene)
-    real = solve_module._active_set_solution
+    real = linear_step.active_set_solution
     seen: list[tuple[int, int]] = []
 
     def counted(model, load_factor, start=None):
         seen.append((id(model), model.size))
         return real(model, load_factor, start)
 
-    monkeypatch.setattr(solve_module, "_active_set_solution", counted)
+    monkeypatch.setattr(linear_step, "active_set_solution", counted)
     choice = choose_core_levels(scene, None, options)
     assert len(seen) >= 3  # the floor, its look-ahead, at least one raise
     assert len(set(seen)) == len(seen), seen
@@ -259,7 +258,7 @@ def test_the_level_choice_solves_each_model_once(monkeypatch):
     def afresh(model, load_factor, start=None):
         return real(model, load_factor, None)
 
-    monkeypatch.setattr(solve_module, "_active_set_solution", afresh)
+    monkeypatch.setattr(linear_step, "active_set_solution", afresh)
     again = choose_core_levels(scene, None, options)
     assert np.array_equal(choice.levels, again.levels)
     assert np.any(choice.levels > 1)
@@ -281,21 +280,21 @@ def test_linear_responses_are_the_runs_linear_steps_with_fewer_passes(monkeypatc
     at each level (reference: ``run``, each solve from every pair open): the probe's value at
     unit load is until / λ of the run, to round-off; the second level's active-set solve starts
     from the first level's set and takes fewer passes than from every pair open."""
-    from sandwich.beam.solve import linear_responses
+    from sandwich.beam import linear_step
+    from sandwich.beam.core_choice import linear_responses
 
-    solve_module = sys.modules["sandwich.beam.solve"]
     scene = dataclasses.replace(_debonded_bend(), beam_model=dataclasses.replace(
         _debonded_bend().beam_model, elements=24), analysis=Analysis(
         kind="nonlinear", until_probe="w_top_mid", until_value=-4.0))
-    real = solve_module._active_set_solution
+    real = linear_step.active_set_solution
     passes = []
 
     def counted(model, load_factor, start=None):
         out = real(model, load_factor, start)
-        passes.append((model.size, start is not None, out[1]))
+        passes.append((model.size, start is not None, out.passes))
         return out
 
-    monkeypatch.setattr(solve_module, "_active_set_solution", counted)
+    monkeypatch.setattr(linear_step, "active_set_solution", counted)
     lo, hi = linear_responses(scene, (1, 3))
     seeded = passes[-1]
     passes.clear()
@@ -311,7 +310,7 @@ def test_linear_responses_are_the_runs_linear_steps_with_fewer_passes(monkeypatc
 def test_linear_responses_without_a_probe_are_compliances():
     """A load target: the response is the compliance fᵀu at λ = 1, against the runner's linear
     step at λ = until_load_factor (fᵀu / λ; homogeneous in λ > 0 with unilateral contact)."""
-    from sandwich.beam.solve import linear_responses
+    from sandwich.beam.core_choice import linear_responses
 
     scene = dataclasses.replace(_debonded_bend(), beam_model=dataclasses.replace(
         _debonded_bend().beam_model, elements=24), analysis=Analysis(
@@ -328,24 +327,24 @@ def test_linear_contact_added_on_the_tangents_pattern_is_scipys_sum():
     """The active-set passes add the linearised contact at its slots of K₀'s pattern instead of
     forming scipy's sum (whose pattern drops K₀'s explicit zeros) and embedding it back: every
     entry the same bits as the sum's, and None for an entry outside the pattern."""
-    from sandwich.beam.solve import _linear_contact_matrix, _pattern_keys, _plus_on_pattern
+    from sandwich.beam.linear_step import linear_contact_matrix, pattern_keys, plus_on_pattern
 
     model = build_model(_debonded_bend(), elements=24, core_level=2)
     K0 = model.tangent(np.zeros(model.size))
-    keys = _pattern_keys(model, K0)
+    keys = pattern_keys(model, K0)
     assert keys is not None and np.all(np.diff(keys) > 0)
     rng = np.random.default_rng(3)
     active = [rng.random(p.size) < 0.5 for p in model.pairs]
-    C = _linear_contact_matrix(model, active)
+    C = linear_contact_matrix(model, active)
     assert C.nnz > 0
-    got, want = _plus_on_pattern(K0, C, keys), (K0 + C).tocsr()
+    got, want = plus_on_pattern(K0, C, keys), (K0 + C).tocsr()
     assert got.indices is K0.indices or np.array_equal(got.indices, K0.indices)
     diff = got - want
     assert diff.count_nonzero() == 0  # the same bits where the sum has entries, zeros elsewhere
     assert np.array_equal(got.toarray(), want.toarray())
     far = sp.csr_matrix(([1.0], ([0], [model.size - 1])), shape=K0.shape)  # no such coupling
-    assert _plus_on_pattern(K0, far, keys) is None
-    assert _pattern_keys(model, want) is None  # the sum is not on the pattern
+    assert plus_on_pattern(K0, far, keys) is None
+    assert pattern_keys(model, want) is None  # the sum is not on the pattern
 
 
 def test_the_linear_step_of_a_long_debond_settles():
@@ -357,8 +356,8 @@ def test_the_linear_step_of_a_long_debond_settles():
     from pathlib import Path
 
     from sandwich.beam import run
-    from sandwich.beam.contact import NORMAL_SIGN
-    from sandwich.beam.solve import _active_set_solution
+    from sandwich.beam.contact_search import NORMAL_SIGN
+    from sandwich.beam.linear_step import active_set_solution
     from sandwich.scene_file import load_scene
 
     root = Path(__file__).resolve().parents[2]
@@ -369,9 +368,9 @@ def test_the_linear_step_of_a_long_debond_settles():
     r = run(scene)
     assert r.solution.converged and r.states[-1].iterations > 50
     model = r.model
-    u, passes, active = _active_set_solution(model, 1.0)
+    u, passes, active = active_set_solution(model, 1.0)
     closed = [np.ones(p.size, dtype=bool) for p in model.pairs]
-    u2, _, active2 = _active_set_solution(model, 1.0, closed)
+    u2, _, active2 = active_set_solution(model, 1.0, closed)
     assert all(np.array_equal(a, b) for a, b in zip(active, active2, strict=True))
     assert np.max(np.abs(u2 - u)) <= 1e-10 * np.max(np.abs(u))
     v = model.expand(u)[model.pairs[0].dofs]

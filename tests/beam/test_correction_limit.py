@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 from beam_scenes import Debond, sandwich_scene  # noqa: I001
 
-from sandwich.beam.contact import CONTACT_DOFS, SHIFT, gap_change
-from sandwich.beam.dofs import global_dof
-from sandwich.beam.model import build_model
+from sandwich.beam import build_model
+from sandwich.beam.contact import gap_change
+from sandwich.beam.contact_law import SHIFT
+from sandwich.beam.dofs import CONTACT_DOFS, global_dof
 
 
 @pytest.fixture(scope="module", params=["closest-point", "same-x"])

@@ -14,8 +14,8 @@ rule (quadrature.py); raising the order must change f_int only at round-off.
 import numpy as np
 from beam_scenes import Debond, sandwich_scene
 
+from sandwich.beam import build_model
 from sandwich.beam.dofs import DOF_TABLE, NODE_DOFS, global_dof
-from sandwich.beam.model import build_model
 
 
 def _free_model(face_stretch=False):

@@ -5,8 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sandwich.beam import build_model
 from sandwich.beam.mesh import build_mesh
-from sandwich.beam.model import build_model
 from sandwich.scene_file import load_scene
 
 SCENES = Path(__file__).parents[2] / "scenes"

@@ -12,8 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sandwich.beam import run
-from sandwich.beam.model import build_model
+from sandwich.beam import build_model, run
 from sandwich.beam.solve import linear_solution
 from sandwich.scene_file import load_scene
 

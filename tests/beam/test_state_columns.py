@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import sandwich.beam.model as model_module
-from sandwich.beam.model import CONTACT_COLUMNS, contact_columns
+from sandwich.beam.contact_summary import CONTACT_COLUMNS, contact_columns
 from sandwich.beam.solve import run
 from sandwich.scene_file import load_scene
 

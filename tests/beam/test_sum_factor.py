@@ -1,7 +1,7 @@
 """Sum-factorised layer kernel (sandwich.beam.sum_factor) against the packed kernel and NumPy.
 
 The factored kernel integrates the same integrand with the same Gauss points, weights and point
-matrices as the packed kernel (sandwich.beam.kernels._kernel) and the NumPy reference
+matrices as the packed kernel (sandwich.beam.packed_kernel.packed_kernel) and the NumPy reference
 (sandwich.beam.element); only the order of the summation changes (ξ first, then η). So every
 force and tangent must agree with both to round-off (references: the NumPy path and the packed
 kernel, independent code), on strongly deformed states, at every core level and basis, and in a
@@ -15,11 +15,10 @@ import numpy as np
 import pytest
 from beam_scenes import KEVLAR, ROHACELL, Debond, sandwich_scene  # noqa: I001
 
-from sandwich.beam import element, kernels
+from sandwich.beam import build_model, element, kernels
 from sandwich.beam.constitutive import core_stiffness, face_stiffness
 from sandwich.beam.core_basis import CoreBasis
 from sandwich.beam.layer_operators import build_core_operators, build_layer_operators
-from sandwich.beam.model import build_model
 from sandwich.beam.quadrature import EXACT_ORDER
 from sandwich.beam.sum_factor import CHUNK, factored_operators
 
@@ -176,7 +175,7 @@ def test_model_with_mixed_levels_matches_packed_and_numpy_paths(basis, mode):
                               ("auto", True, "auto")):
         model.use_kernels = compiled
         mode(m)
-        model._cache = None
+        model.forget_evaluations(contact_kinematics=False)
         results[name] = model.internal_force(u), model.tangent(u)
     f0, K0 = results["numpy"]
     for name in ("packed", "auto"):

@@ -1,4 +1,4 @@
-"""The tangent's CSR value arrays are reused between evaluations (``BeamModel._zeroed_values``).
+"""The tangent's CSR value arrays are reused between evaluations (``zeroed_values``).
 
 A reused array must never be one a caller still holds (a matrix or a view of its values), and a
 reused one must start from zero: the references are copies taken before, and a fresh model's
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sandwich.beam.model import build_model
+from sandwich.beam import build_model
 from sandwich.beam.solve import linear_solution
 from sandwich.scene_file import load_scene
 
@@ -44,7 +44,7 @@ def test_a_released_array_is_reused_and_starts_from_zero(states):
     scene, model, us = states
     for u in us:
         model.tangent(u)  # each drops the last matrix: its array comes free for reuse
-    before = {b.ctypes.data for b in model._spare_values}  # addresses: no extra reference
+    before = {b.ctypes.data for b in model.compiled.spare_values}  # addresses: no extra reference
     K = model.tangent(us[0] * 0.9)  # not the cached state: a new evaluation
     assert K.data.base.ctypes.data in before  # an array of the list, not a new one
     fresh = build_model(scene, elements=40, core_level=2).tangent(us[0] * 0.9)

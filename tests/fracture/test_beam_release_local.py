@@ -1,4 +1,4 @@
-"""The closure's tie reactions from the elements next to the tips only (``_closure_support``).
+"""The closure's tie reactions from the elements next to the tips only (``closure_support``).
 
 :func:`sandwich.beam.fracture.tip_releases` evaluates the layers of the elements whose forces
 reach the tie reactions it reads (and every contact pair), not the whole beam. Reference: the
@@ -13,7 +13,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sandwich.beam.fracture import _closure, beam_tips, closure_elements, tip_releases
+from sandwich.beam.fracture import (
+    beam_tips,
+    closure_elements,
+    closure_from_force,
+    tip_releases,
+)
 from sandwich.beam.solve import run
 from sandwich.scene_file import load_scene
 
@@ -41,7 +46,8 @@ def test_tip_releases_equal_the_closure_on_the_full_force(core):
     for st in r.states[len(r.states) // 2:]:
         u_full = model.expand(st.u)
         f_full = model.full_response(u_full, tangent=False)[0]
-        full = [_closure(model, u_full, f_full, t, closure_elements(model, t)) for t in tips]
+        full = [closure_from_force(model, u_full, f_full, t, closure_elements(model, t))
+                for t in tips]
         local = tip_releases(model, st.u, tips)
         for a, b in zip(full, local, strict=True):
             assert a.G > 0.0

@@ -1,0 +1,103 @@
+"""The beam's result in the project's common form: :func:`beam_solution`.
+
+Per converged state the history's record (probes, contact, energy release rates at the debond
+tips), the profiles and the ParaView field frames of the chosen states, and the summary entries.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sandwich.beam.build import scene_gauss_orders
+from sandwich.beam.contact_summary import CONTACT_COLUMNS, contact_columns
+from sandwich.beam.fields import profile_columns, section_fields
+from sandwich.beam.fracture import beam_tips, column_names, release_columns
+from sandwich.beam.model import BeamModel
+from sandwich.beam.states import ConvergedState
+from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
+
+
+def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> FieldFrame:
+    """Faces and core of ``state`` on one quad grid (``section_fields``) as a ParaView frame.
+
+    Point data: σ_x, σ_z, τ, von Mises (MPa, 2nd Piola-Kirchhoff); cell data: ``region``
+    (0 core, 1 top face, 2 bottom face) and ``core_level`` (0 on faces). Points are reference
+    (x, z), displacement (u, w) in mm.
+    """
+    f = section_fields(model, state.u, nonlinear=nonlinear)
+    return FieldFrame(
+        step=state.step, load_factor=state.load_factor, points=f.points, cells=f.cells,
+        displacement=f.displacement,
+        point_data={"sigma_x": f.sigma_x, "sigma_z": f.sigma_z, "tau": f.tau,
+                    "von_mises": f.von_mises},
+        cell_data={"region": f.region.astype(float), "core_level": f.core_level.astype(float)},
+    )
+
+
+def beam_solution(
+    scene: object, model: BeamModel, states: list[ConvergedState], nonlinear: bool,
+    converged: bool, message: str, limit_points: list[LimitPoint],
+) -> Solution:
+    """The common :class:`~sandwich.results.Solution` of ``states`` (model "beam").
+
+    The history's contact and energy release rate columns are the path's where it kept them
+    (:meth:`~sandwich.beam.model.BeamModel.state_columns`), else evaluated (a linear analysis
+    has no contact columns: zeros); profiles and field frames every ``profile_every`` steps and
+    at the last state; a penetration beyond the model's bound is a WARNING of the message.
+    """
+    history = []
+    max_pen = max_slide = 0.0
+    tips = beam_tips(scene, model)  # energy release rate at every debond tip (N/mm)
+    names = {n for t in tips for n in column_names(t.debond, t.tip)}
+    for s in states:
+        # the path's columns of this state (model.state_columns), else evaluated
+        contact = ({n: s.extra[n] for n in CONTACT_COLUMNS} if set(CONTACT_COLUMNS) <=
+                   s.extra.keys() else _contact_columns(model, s.u, nonlinear))
+        max_pen = max(max_pen, contact["max_penetration"])
+        max_slide = max(max_slide, contact["max_sliding"])
+        extra = {**contact,
+                 **({n: s.extra[n] for n in names} if names <= s.extra.keys()
+                    else release_columns(model, s.u, tips))}
+        history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
+                                  iterations=s.iterations, extra=extra))
+    every = int(getattr(getattr(scene, "beam_model", None), "profile_every", 0) or 0)
+    chosen = [s for s in states if every and s.step % every == 0 and s is not states[-1]]
+    chosen.append(states[-1])
+    profiles = [Profile(step=s.step, columns=profile_columns(model, s.u, nonlinear))
+                for s in chosen]
+    fields = [_field_frame(model, s, nonlinear) for s in chosen]
+    bound = model.penetration_bound()
+    if max_pen > bound:
+        message += (f"; WARNING: contact penetration {max_pen:.3g} mm exceeds "
+                    f"{bound:.3g} mm (raise beam_model.contact_penalty)")
+    return Solution(
+        model="beam", scene=scene.name, history=history, profiles=profiles, converged=converged,
+        message=message, limit_points=limit_points, wall_seconds=0.0, dofs=model.size,
+        fields=fields,
+        extra={
+            "elements": model.mesh.n_elements,
+            "nodes": model.mesh.n_nodes,
+            "analysis": "nonlinear" if nonlinear else "linear",
+            **{f"gauss_{layer}_{axis}": n for layer, orders in scene_gauss_orders(scene).items()
+               for axis, n in zip(("x", "z"), orders, strict=True)},
+            "contact_pairs": int(sum(p.size for p in model.pairs)),
+            "contact_penalty": model.penalty,
+            "max_penetration": max_pen,
+            "penetration_bound": bound,
+            "max_sliding": max_slide,
+            "total_newton_iterations": int(sum(s.iterations for s in states)),
+        },
+    )
+
+
+def _contact_columns(model: BeamModel, u: np.ndarray, nonlinear: bool) -> dict[str, float]:
+    """A state's contact history columns, evaluated (a linear analysis: none, zeros)."""
+    return contact_columns(model.contact_summary(u) if nonlinear else {})
+
+
+def growth_summary(scene: object, solution: Solution) -> dict[str, object]:
+    """Summary entry of the debond growth criterion (debonds with a toughness only)."""
+    from sandwich.fracture import growth_onset
+
+    onset = growth_onset(scene, solution.history)
+    return {"debond_growth": onset} if onset else {}
