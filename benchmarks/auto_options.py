@@ -12,7 +12,8 @@ user would set it in the scene (no code path that users cannot reach):
 - ``auto, max level 2``: ``max_core_level = 2``;
 - ``one pass, zones L3`` / ``L2``: ``auto`` with ``core_zones`` at the cap (3, or 2 with
   ``max_core_level = 2``) over every debond and load patch widened by a core thickness — the
-  elements auto's nonlinear check always raises (``sandwich.beam.solve._local_zone_elements``).
+  elements auto's nonlinear check always raises
+  (``sandwich.beam.core_controller.local_zone_elements``).
   With those zones at the cap the check has nothing to raise, so the path is followed once;
   the reported estimate is then the linear step's only (said in the table);
 - ``L1`` (the paper's core, what the speed targets were measured on), ``L2``, ``L3``: every
@@ -36,10 +37,9 @@ import numpy as np
 
 from benchmarks.core_levels import case_scene, reference
 from benchmarks.provenance import RESULTS, add_out_argument, measured_on
-from sandwich.beam import run
+from sandwich.beam import build_model, run, scene_model_options
+from sandwich.beam.core_controller import local_zone_elements
 from sandwich.beam.core_levels import LevelChoice
-from sandwich.beam.model import build_model
-from sandwich.beam.solve import _local_zone_elements, scene_model_options
 from sandwich.scene import CoreZone
 
 OUT = RESULTS / "beam"
@@ -52,7 +52,7 @@ FIELDS = ["case", "variant", "seconds", "error", "estimate", "estimate_from", "p
 def local_zones(scene: object, level: int) -> tuple[CoreZone, ...]:
     """``core_zones`` at ``level`` over the elements auto's nonlinear check always raises."""
     model = build_model(scene, elements=scene.beam_model.elements, **scene_model_options(scene))
-    levels = np.where(_local_zone_elements(scene, model), level, 1)
+    levels = np.where(local_zone_elements(scene, model), level, 1)
     return tuple(CoreZone(start=z["start"], end=z["end"], level=z["level"])
                  for z in LevelChoice(levels=levels, how="explicit").zones(model.mesh)
                  if z["level"] > 1)

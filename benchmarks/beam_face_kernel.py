@@ -78,7 +78,7 @@ def face_evaluation(model, u_full, before):
     slots = model.pattern.family_slots
     data = np.zeros(model.pattern.indices.size)
     lengths = model.mesh.lengths
-    for i, (op, products, els, dofs) in enumerate(model._families()):
+    for i, (op, products, els, dofs) in enumerate(model.element_families()):
         if op.name not in ("top", "bottom"):
             continue
         if not before:

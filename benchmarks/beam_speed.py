@@ -84,7 +84,8 @@ def kernel_flops(model) -> float:
     The packed kernel's GEMMs (``kernels.point_flops``) or, for the layers the sum-factorised
     kernel evaluates (core levels 2-4), its two stages (``kernels.layer_flops``).
     """
-    return float(sum(els.size * kernels.layer_flops(op) for op, _, els, _ in model._families()))
+    return float(sum(els.size * kernels.layer_flops(op)
+                     for op, _, els, _ in model.element_families()))
 
 
 def deformed_state(model):
@@ -130,7 +131,7 @@ def newton_iteration_times(cases, repeat):
         u = path_state(model)
         repeat_here = repeat * (5 if model.size < SMALL_DOFS else 1)  # ms-scale: more tries
         t_eval, K = best_of(partial(evaluate, model, u), repeat_here)
-        model.__dict__.pop("_envelopes", None)  # the symbolic part as a path builds it
+        model.factorisations.structures.clear()  # the symbolic part as a path builds it
         model.factorize(K)
         t_fac, fac = best_of(partial(model.factorize, K), repeat_here)
         r = model.internal_force(u) - model.f_ref

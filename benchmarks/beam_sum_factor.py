@@ -47,7 +47,8 @@ def _timed(fn, repeat):
 
 def kernel_flops(model) -> float:
     """Flops of the layer kernels per evaluation, of the kernel each layer uses now."""
-    return float(sum(els.size * kernels.layer_flops(op) for op, _, els, _ in model._families()))
+    return float(sum(els.size * kernels.layer_flops(op)
+                     for op, _, els, _ in model.element_families()))
 
 
 def evaluate(model, u):

@@ -5,7 +5,7 @@ auto] [--factors 1 10] [--out DIR]``. Writes ``benchmarks/results/beam/contact_w
 (a rerun replaces them).
 
 The penalty law of a debonded interface (``sandwich.beam.contact.pressure_law``) is regularised
-over a width s (default ``sandwich.beam.model.default_contact_smoothing``,
+over a width s (default ``sandwich.beam.build.default_contact_smoothing``,
 1e-6 mm on the shipped scenes). Newton converges linearly on pairs in the law's exponential
 tail (docs/beam_speed.md, "What bounds the rest"), which sets the iteration count of every
 debond scene. This benchmark solves each scene in this process with s × each factor
@@ -25,7 +25,8 @@ import time
 
 from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
 from sandwich.beam import run
-from sandwich.beam.model import BeamModel, default_contact_smoothing
+from sandwich.beam.build import default_contact_smoothing
+from sandwich.beam.model import BeamModel
 from sandwich.scene_file import load_scene
 
 OUT = RESULTS / "beam"

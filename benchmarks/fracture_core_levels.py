@@ -36,9 +36,9 @@ from benchmarks.cases.fracture_cases import (
     shear_loads,
 )
 from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from sandwich.beam import build_model
 from sandwich.beam.constraints import NodeSupport, build_dof_map
 from sandwich.beam.fracture import beam_tips, closure_release, tip_releases
-from sandwich.beam.model import build_model
 from sandwich.beam.solve import linear_solution
 
 OUT = RESULTS / "fracture"
@@ -58,7 +58,7 @@ def _untied(model, sc, node):
     mode_active = (model.dof_map.free[n_paper:] >= 0).reshape(model.mesh.n_nodes,
                                                               extra // model.mesh.n_nodes)
     return dataclasses.replace(model, dof_map=build_dof_map(model.mesh.n_nodes, bonded, supports,
-                                                            mode_active), _cache=None)
+                                                            mode_active))
 
 
 def measure(sc, levels, elements):
