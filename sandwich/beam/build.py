@@ -46,7 +46,11 @@ FACES = ("top", "bottom")
 
 
 def mesh_stations(scene: object) -> list[float]:
-    """X positions that must be nodes: debond ends, supports, loads (patch edges), probes."""
+    """X positions that must be nodes: debond ends, supports, loads (patch edges).
+
+    Probes are not: each is read where it falls by the element's interpolation
+    (:func:`~sandwich.beam.loads.probe_row`), so any number of them leaves the mesh as it is.
+    """
     pts: list[float] = []
     for d in scene.debonds:
         if d.end > d.start:  # a zero-length debond unties no node: not a station
@@ -54,7 +58,6 @@ def mesh_stations(scene: object) -> list[float]:
     pts += [s.x for s in scene.supports]
     for load in scene.loads:
         pts += [load.x] if load.width == 0 else [*load.span, load.x]
-    pts += [p.x for p in scene.probes]
     return pts
 
 
