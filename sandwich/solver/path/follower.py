@@ -43,7 +43,11 @@ DIVERGENCE_RISES = 2
 
 
 class PathFollower(RescueSteps, CriticalPoints, StepSizeControl):
-    """State machine of :func:`follow_path` (one instance per call): the parts composed."""
+    """State machine of :func:`follow_path` (one instance per call): the parts composed.
+
+    Every method is defined in exactly one part (none overrides another), so the order of the
+    bases decides nothing; each part's bases are the parts whose methods it calls.
+    """
 
     def run(self) -> PathResult:
         """Follow the path, calling ``progress`` with every converged state."""
