@@ -12,13 +12,14 @@ from sandwich.solver.sparse import (
     SparseSystemMixin,
     factorize_symmetric,
 )
-from sandwich.solver.system import DiscreteSystem, Factorization
+from sandwich.solver.system import DiscreteSystem, Factorization, OptionalHooks
 
 __all__ = [
     "DiscreteSystem",
     "Factorization",
     "NewtonResult",
     "NewtonSettings",
+    "OptionalHooks",
     "PathOptions",
     "PathResult",
     "PathState",

@@ -5,7 +5,7 @@
   the path follower locates it within the step before or after that state from the load
   curve's slopes (:mod:`sandwich.solver.extrema`, a state's ``extremum``; in a step that
   jumped a snap — a probe rescue, or an arc step whose corrector moved far — by walking the
-  branch it left to its end: :meth:`sandwich.solver.path._Follower._walk_branch_left`), and it
+  branch it left to its end: :meth:`sandwich.solver.path.PathFollower.walk_branch_left`), and it
   is reported
   there: ``located_at`` the fraction of that step's probe change, ``between`` that step's two
   load factors. Without a located one it is reported at the extreme state (exact only to the
@@ -21,7 +21,7 @@ Each point carries ``between``: the load factors of the two converged states tha
 along the path (its step's states; an extremum not located: the states either side of it),
 so a user sees to what resolution the path sampled it. A bifurcation whose state
 carries a ``crossing`` (located within its step by the path follower:
-:meth:`sandwich.solver.path._Follower._locate_crossing`) is reported there instead: its load
+:meth:`sandwich.solver.path.PathFollower.locate_crossing`) is reported there instead: its load
 factor and probes are the located point's, ``between`` the bracket it was located in (the
 step's states, or equilibria solved inside the step), ``located_at`` its fraction of the step.
 Without one (a change of the count shared with a limit point, a location that failed, states

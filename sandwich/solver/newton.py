@@ -43,7 +43,7 @@ full steps. A probe or load constraint stays satisfied to first order: each iter
 recomputed from the current iterate.
 
 Contact-limited corrections (``limit_corrections``, off by default; the path follower turns it
-on for the rest of a path once one of its correctors has failed, ``sandwich/solver/path.py``):
+on for the rest of a path once one of its correctors has failed, :mod:`sandwich.solver.path`):
 a system with ``correction_limit(u, du)`` may shorten a correction to the fraction α it returns
 (at least :data:`MIN_CORRECTION_FRACTION`). Where a contact pair is open, the tangent carries no
 contact stiffness for it, and a correction that closes it is blind to the penalty it meets:
@@ -64,7 +64,7 @@ iterate, a singular tangent, a constraint without solution, a residual grown by 
 row while above the first one, or ``max_iterations`` corrections without convergence.
 
 The rising test (off by default; the path follower turns it on for a step's attempts until
-one fails by it, ``sandwich/solver/path.py``), after the cut-back rule of commercial codes (a
+one fails by it, :mod:`sandwich.solver.path`), after the cut-back rule of commercial codes (a
 residual growing in two consecutive iterations abandons the increment), stops an iteration that
 has left the basin of the solution early: on fig. 5's level-3 pass two attempts wandered for 25
 and 17 iterations at residuals 1e4-1e6 (the start: 2e4 and 5e3) before failing, 1.5 s of the

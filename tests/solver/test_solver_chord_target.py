@@ -1,4 +1,4 @@
-"""A crossed stopping target hit by one corrector from the chord (``_Follower._chord_target``).
+"""A crossed stopping target hit by one corrector from the chord (``PathFollower.chord_target``).
 
 When a step overshoots ``until``, the follower first runs one corrector under control of the
 crossed quantity from the point where the chord last → trial meets the target, and only if
@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from solver_toys import VonMisesTruss
 
-import sandwich.solver.path as path_module
+import sandwich.solver.path.attempts as attempts_module
 from sandwich.solver import PathOptions, follow_path
-from sandwich.solver.path import PathState, _Follower, _Trial
+from sandwich.solver.path import PathFollower, PathState, Trial
 
 TOL = 1e-10
 
@@ -34,15 +34,15 @@ def _run(monkeypatch, chord: bool):
     truss = VonMisesTruss(spring=2000.0)
     target = 0.3 * truss.limit_points()[0][0]  # w2 well before the limit point
     calls = []
-    real = path_module.newton_correct
+    real = attempts_module.newton_correct
 
     def counting(*args, **kwargs):
         calls.append(1)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(path_module, "newton_correct", counting)
+    monkeypatch.setattr(attempts_module, "newton_correct", counting)
     if not chord:
-        monkeypatch.setattr(_Follower, "_chord_target", lambda *a, **k: None)
+        monkeypatch.setattr(PathFollower, "chord_target", lambda *a, **k: None)
     opts = PathOptions(control="arc-length", until_probe="w2", until_value=target, tol=TOL,
                        initial_increment=0.15 * target)
     result = follow_path(truss, opts, ["w1", "w2"])
@@ -79,7 +79,7 @@ def _step(past: bool, trial_w1: float | None = None, psi: float = 1.0):
     truss = VonMisesTruss(spring=2000.0)
     (w_max, _), (w_min, _) = truss.limit_points()
     opts = PathOptions(control="arc-length", until_probe="w1", until_value=w_min, tol=TOL)
-    f = _Follower(truss, opts, ["w1", "w2"], None)
+    f = PathFollower(truss, opts, ["w1", "w2"], None)
     f.psi, f.prev_step, f.sigma = psi, None, 1.0
 
     def state(w1):
@@ -93,7 +93,7 @@ def _step(past: bool, trial_w1: float | None = None, psi: float = 1.0):
     u1, lam1 = state(trial_w1 if trial_w1 is not None
                      else 0.5 * (w_max + w_min) if past else 0.8 * w_max)
     fac1 = truss.factorize(truss.tangent(u1))
-    return truss, f, last, _Trial(u1, lam1, 3, fac1), fac0, fac1
+    return truss, f, last, Trial(u1, lam1, 3, fac1), fac0, fac1
 
 
 def test_a_step_across_a_critical_point_is_left_to_regula_falsi():
@@ -101,12 +101,12 @@ def test_a_step_across_a_critical_point_is_left_to_regula_falsi():
     assert (fac0.negative_pivots, fac1.negative_pivots) == (0, 1)  # the toy crosses the max
     frac, name, target = 0.5, "w1", 0.5 * (last.u[0] + trial.u[0])
     before = truss.evaluations
-    assert f._chord_target(name, target, frac, last, trial) is None
+    assert f.chord_target(name, target, frac, last, trial) is None
     assert truss.evaluations == before  # refused before any corrector
 
 
 def _chord(f, last, trial):
-    return f._chord_target("w1", 0.5 * (last.u[0] + trial.u[0]), 0.5, last, trial)
+    return f.chord_target("w1", 0.5 * (last.u[0] + trial.u[0]), 0.5, last, trial)
 
 
 def test_a_regular_step_is_hit_from_its_chord():
@@ -136,7 +136,7 @@ def test_a_result_outside_the_steps_load_bracket_is_refused():
     (_, _), (w_min, _) = truss.limit_points()
     target = 1.02 * w_min
     frac = (target - last.u[0]) / (trial.u[0] - last.u[0])
-    assert f._chord_target("w1", target, frac, last, trial) is None
+    assert f.chord_target("w1", target, frac, last, trial) is None
     assert float(truss.bar_force(target)) < min(last.load_factor, trial.load_factor)
 
 
@@ -151,7 +151,7 @@ def test_a_result_with_other_inertia_than_the_step_is_refused():
     assert truss.factorize(truss.tangent(np.array([target, target + lam / truss.ks]))) \
         .negative_pivots == 1
     frac = (target - last.u[0]) / (trial.u[0] - last.u[0])
-    assert f._chord_target("w1", target, frac, last, trial) is None
+    assert f.chord_target("w1", target, frac, last, trial) is None
 
 
 @pytest.mark.parametrize("which", ["last", "trial"])
@@ -160,7 +160,7 @@ def test_unknown_inertia_is_left_to_regula_falsi(which):
     if which == "last":
         last = PathState(0, last.u, last.load_factor, 0, last.probes, None)
     else:
-        trial = _Trial(trial.u, trial.load_factor, 3, _NoInertia(fac1))
+        trial = Trial(trial.u, trial.load_factor, 3, _NoInertia(fac1))
     before = truss.evaluations
     assert _chord(f, last, trial) is None
     assert truss.evaluations == before
@@ -181,7 +181,7 @@ def _across(target_fraction=0.5):
     assert (fac0.negative_pivots, fac1.negative_pivots) == (0, 1)
     target = last.u[1] + target_fraction * (trial.u[1] - last.u[1])
     opts = PathOptions(control="arc-length", until_probe="w2", until_value=target, tol=TOL)
-    f = _Follower(truss, opts, ["w1", "w2"], None)
+    f = PathFollower(truss, opts, ["w1", "w2"], None)
     f.psi, f.prev_step, f.sigma = 1.0, None, 1.0
     last = PathState(0, last.u, last.load_factor, 0, f.probes(last.u), 0)
     f.states = [last]
@@ -192,15 +192,15 @@ def _across(target_fraction=0.5):
 def test_a_step_across_the_maximum_hits_the_target_under_its_own_control(monkeypatch):
     truss, f, last, trial, t, target = _across()
     arcs = []
-    real = _Follower._attempt
-    monkeypatch.setattr(_Follower, "_attempt", lambda self, *a, **k: arcs.append(1) or
+    real = PathFollower.attempt
+    monkeypatch.setattr(PathFollower, "attempt", lambda self, *a, **k: arcs.append(1) or
                         real(self, *a, **k))
-    monkeypatch.setattr(_Follower, "_chord_target", lambda *a, **k: pytest.fail("chord"))
+    monkeypatch.setattr(PathFollower, "chord_target", lambda *a, **k: pytest.fail("chord"))
     goals = []
-    control = _Follower._control_to
-    monkeypatch.setattr(_Follower, "_control_to", lambda self, name, goal, *a: goals.append(goal)
+    control = PathFollower.control_to
+    monkeypatch.setattr(PathFollower, "control_to", lambda self, name, goal, *a: goals.append(goal)
                         or control(self, name, goal, *a))
-    hit, _, name = f._hit_crossed_target(trial, 1.0, last, t)
+    hit, _, name = f.hit_crossed_target(trial, 1.0, last, t)
     assert name == "w2" and not arcs  # neither the chord nor regula falsi's arcs
     # the first sub-increment covers half the distance (last's tangent, before the maximum)
     assert math.isclose(goals[0], 0.5 * (last.u[1] + target), rel_tol=1e-12)
@@ -217,12 +217,12 @@ def test_a_step_across_the_maximum_hits_the_target_under_its_own_control(monkeyp
 def test_across_the_maximum_a_failed_target_control_falls_back_to_regula_falsi(monkeypatch):
     truss, f, last, trial, t, target = _across()
     tries, arcs = [], []
-    monkeypatch.setattr(_Follower, "_attempt_target", lambda *a, **k: tries.append(1))
-    real = _Follower._attempt
-    monkeypatch.setattr(_Follower, "_attempt", lambda self, *a, **k: arcs.append(1) or
+    monkeypatch.setattr(PathFollower, "attempt_target", lambda *a, **k: tries.append(1))
+    real = PathFollower.attempt
+    monkeypatch.setattr(PathFollower, "attempt", lambda self, *a, **k: arcs.append(1) or
                         real(self, *a, **k))
     h = f.wnorm(trial.u - last.u, trial.load_factor - last.load_factor)
-    _, _, name = f._hit_crossed_target(trial, h, last, t)
+    _, _, name = f.hit_crossed_target(trial, h, last, t)
     assert name == "w2"
     assert tries == [1]  # tried once, first, not again after regula falsi
     assert arcs  # regula falsi's shortened arcs

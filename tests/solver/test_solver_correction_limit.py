@@ -12,8 +12,8 @@ import pytest
 from solver_toys import ToySystem
 
 from sandwich.solver import NewtonSettings, PathOptions, follow_path, solve_equilibrium
-from sandwich.solver import path as path_module
 from sandwich.solver.newton import LIMITED_CORRECTIONS, MIN_CORRECTION_FRACTION, NewtonResult
+from sandwich.solver.path import attempts
 
 TOL = 1e-10
 
@@ -99,7 +99,7 @@ def test_a_failed_corrector_turns_limits_on_for_the_rest_of_the_path(monkeypatch
 
     def run(*fail_calls):
         seen = []
-        real = path_module.newton_correct
+        real = attempts.newton_correct
 
         def spy(system, u, lam, constraint, settings, *args):
             seen.append(settings.limit_corrections)
@@ -107,7 +107,7 @@ def test_a_failed_corrector_turns_limits_on_for_the_rest_of_the_path(monkeypatch
                 return NewtonResult(False, np.array(u, dtype=float), lam, 1, 1.0, "scripted")
             return real(system, u, lam, constraint, settings, *args)
 
-        monkeypatch.setattr(path_module, "newton_correct", spy)
+        monkeypatch.setattr(attempts, "newton_correct", spy)
         opts = PathOptions(control="load", until_load_factor=3.0, initial_increment=0.5,
                            max_increment=0.5, tol=TOL)
         result = follow_path(SpringOnWall(), opts, ["u"])
@@ -124,7 +124,7 @@ def test_a_step_whose_limited_attempt_failed_is_retried_without_the_limit(monkey
     """Within one step, a failed limited attempt sends the step's further attempts back to
     plain corrections (as the rising test's retries); the next step is limited again."""
     seen = []
-    real = path_module.newton_correct
+    real = attempts.newton_correct
 
     def spy(system, u, lam, constraint, settings, *args):
         seen.append(settings.limit_corrections)
@@ -132,7 +132,7 @@ def test_a_step_whose_limited_attempt_failed_is_retried_without_the_limit(monkey
             return NewtonResult(False, np.array(u, dtype=float), lam, 1, 1.0, "scripted")
         return real(system, u, lam, constraint, settings, *args)
 
-    monkeypatch.setattr(path_module, "newton_correct", spy)
+    monkeypatch.setattr(attempts, "newton_correct", spy)
     opts = PathOptions(control="load", until_load_factor=3.0, initial_increment=0.5,
                        max_increment=0.5, tol=TOL)
     assert follow_path(SpringOnWall(), opts, ["u"]).reached_target

@@ -1,6 +1,6 @@
 """A hard step across a critical point and the stopping target is cut, not finished from before.
 
-``_Follower._converge_step`` refuses, up to ``CRITICAL_TARGET_CUTS`` times, a converged trial
+``PathFollower.converge_step`` refuses, up to ``CRITICAL_TARGET_CUTS`` times, a converged trial
 whose tangent's inertia differs from the last state's, which passed the ``until`` target and
 needed more than ``desired_iterations``: the target is then reached by ordinary steps past the
 critical point instead of by the target's control from before it. Toy: the von Mises truss
@@ -16,10 +16,10 @@ from solver_toys import VonMisesTruss
 from sandwich.solver import PathOptions
 from sandwich.solver.path import (
     CRITICAL_TARGET_CUTS,
+    PathFollower,
     PathState,
-    _Follower,
-    _StepSize,
-    _Trial,
+    StepSize,
+    Trial,
 )
 
 TOL = 1e-10
@@ -40,7 +40,7 @@ def _follower(target_fraction: float, past: bool = True, desired: int = 5):
     target = u0[1] + target_fraction * (u1[1] - u0[1])
     opts = PathOptions(control="arc-length", until_probe="w2", until_value=target, tol=TOL,
                        desired_iterations=desired)
-    f = _Follower(truss, opts, ["w1", "w2"], None)
+    f = PathFollower(truss, opts, ["w1", "w2"], None)
     f.psi, f.prev_step, f.sigma = 1.0, None, 1.0
     f.recent, f.peak = [], 0.0
     f.divergence_rises = 0
@@ -57,18 +57,18 @@ def _converge(monkeypatch, f, last, u1, lam1, fac1, iterations):
 
     def attempt(self, h, last_, t, rises=0, limit=None):
         tried.append(h)
-        return _Trial(u1, lam1, iterations, fac1), "converged"
+        return Trial(u1, lam1, iterations, fac1), "converged"
 
-    monkeypatch.setattr(_Follower, "_attempt", attempt)
-    size = _StepSize(1.0, 1e-6, 10.0, f.opt.desired_iterations)
-    out = f._converge_step(size, last, np.zeros(2), 1)
+    monkeypatch.setattr(PathFollower, "attempt", attempt)
+    size = StepSize(1.0, 1e-6, 10.0, f.opt.desired_iterations)
+    out = f.converge_step(size, last, np.zeros(2), 1)
     return out, tried
 
 
 def test_the_toy_step_crosses_the_maximum_and_the_target():
     f, last, u1, lam1, fac1 = _follower(0.5)
     assert (last.negative_pivots, fac1.negative_pivots) == (0, 1)
-    assert f._crossings(last, _Trial(u1, lam1, 9, fac1))
+    assert f.crossings(last, Trial(u1, lam1, 9, fac1))
 
 
 def test_a_hard_step_across_the_maximum_and_the_target_is_cut(monkeypatch):

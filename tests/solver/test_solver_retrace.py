@@ -54,15 +54,15 @@ def test_guarded_arc_goes_forward_past_both_limit_points_to_the_target():
 def test_guard_refuses_a_reversed_step_with_its_reason():
     # a step from the last state back towards the origin (Δu antiparallel to the previous Δu)
     # is refused by the guard, and the message names it
-    from sandwich.solver.path import RETRACE, _Follower
+    from sandwich.solver.path import RETRACE, PathFollower
 
     truss = VonMisesTruss(h=0.2)
-    f = _Follower(truss, _options(0.0, truss.h), ["w"], None)
+    f = PathFollower(truss, _options(0.0, truss.h), ["w"], None)
     f.prev_step = (np.array([0.01]), 0.5)
-    assert f._turns_back(np.array([0.005]), np.array([0.005])) == ""
-    why = f._turns_back(np.array([-0.005]), np.array([0.005]))
+    assert f.turns_back(np.array([0.005]), np.array([0.005])) == ""
+    why = f.turns_back(np.array([-0.005]), np.array([0.005]))
     assert why.startswith(RETRACE) and "180°" in why
     f.opt.control = "arc-length"
     f.sigma = 1.0
-    f._turns_back(np.array([-0.005]), np.array([-0.005]))  # the predictor pointed back too
+    f.turns_back(np.array([-0.005]), np.array([-0.005]))  # the predictor pointed back too
     assert f.sigma == -1.0

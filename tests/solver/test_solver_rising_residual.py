@@ -115,10 +115,10 @@ class HuntingSpring(ToySystem):
 
 
 def test_a_step_cut_by_the_rising_test_is_retried_without_it_and_the_path_drops_it():
-    import sandwich.solver.path as path_module
+    from sandwich.solver.path import attempts
 
     system = HuntingSpring()
-    original = path_module.newton_correct
+    original = attempts.newton_correct
 
     def fresh(sys_, u, lam, constraint, settings, *args, **kwargs):
         sys_.bad = 2
@@ -126,12 +126,12 @@ def test_a_step_cut_by_the_rising_test_is_retried_without_it_and_the_path_drops_
         sys_.attempts.append((settings.divergence_rises, res.converged, res.reason, res.rises))
         return res
 
-    path_module.newton_correct = fresh
+    attempts.newton_correct = fresh
     try:
         result = follow_path(system, PathOptions(control="load", until_load_factor=2.0, tol=TOL),
                              ["u"])
     finally:
-        path_module.newton_correct = original
+        attempts.newton_correct = original
     assert result.reached_target, result.message
     u = np.array([s.probes["u"] for s in result.states[1:]])
     lam = np.array([s.load_factor for s in result.states[1:]])

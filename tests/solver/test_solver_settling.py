@@ -21,7 +21,7 @@ import pytest
 
 from sandwich.scene_file import load_scene
 from sandwich.solver import PathOptions
-from sandwich.solver.path import HALF_REACH, SETTLING_BEND, PathState, _Follower, _Trial
+from sandwich.solver.path import HALF_REACH, SETTLING_BEND, PathFollower, PathState, Trial
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
@@ -33,7 +33,7 @@ def _state(w, lam):
 def _follower(allowance, failed=False, turn=0.0):
     """A follower whose last two steps (of the load curve w ↦ λ, both scaled to 1 at the
     target) turn by ``turn`` radians; the rule reads only these, the options and the flag."""
-    f = _Follower.__new__(_Follower)
+    f = PathFollower.__new__(PathFollower)
     f.opt = PathOptions(settling_allowance=allowance, until_probe="w", until_value=-2.0)
     f.failed_once = failed
     f.lam_est, f.curve_probe = 10.0, ("w", 2.0)
@@ -45,19 +45,19 @@ def _follower(allowance, failed=False, turn=0.0):
 
 
 def _trial(iterations, increment_iterations):
-    return _Trial(None, 0.0, iterations, None, 0, increment_iterations)
+    return Trial(None, 0.0, iterations, None, 0, increment_iterations)
 
 
 def test_the_controller_weighs_a_step_by_its_increment_iterations_plus_the_allowance():
-    assert _follower(2)._weighed_iterations(_trial(8, 1)) == 3
-    assert _follower(2)._weighed_iterations(_trial(4, 3)) == 4  # never more than all of them
-    assert _follower(0)._weighed_iterations(_trial(8, 5)) == 5
+    assert _follower(2).weighed_iterations(_trial(8, 1)) == 3
+    assert _follower(2).weighed_iterations(_trial(4, 3)) == 4  # never more than all of them
+    assert _follower(0).weighed_iterations(_trial(8, 5)) == 5
 
 
 def test_without_the_allowance_or_after_a_failed_corrector_every_iteration_counts():
-    assert _follower(None)._weighed_iterations(_trial(8, 1)) == 8
-    assert _follower(2, failed=True)._weighed_iterations(_trial(8, 1)) == 8
-    assert _follower(2)._weighed_iterations(_trial(8, None)) == 8
+    assert _follower(None).weighed_iterations(_trial(8, 1)) == 8
+    assert _follower(2, failed=True).weighed_iterations(_trial(8, 1)) == 8
+    assert _follower(2).weighed_iterations(_trial(8, None)) == 8
 
 
 def test_where_the_load_curve_bends_every_iteration_counts():
@@ -65,13 +65,13 @@ def test_where_the_load_curve_bends_every_iteration_counts():
     for turn, allowed in ((0.0, True), (0.9 * SETTLING_BEND, True), (-0.9 * SETTLING_BEND, True),
                           (1.1 * SETTLING_BEND, False), (-1.1 * SETTLING_BEND, False),
                           (math.pi / 2, False)):
-        assert _follower(2, turn=turn)._weighed_iterations(_trial(8, 1)) == (3 if allowed else 8)
+        assert _follower(2, turn=turn).weighed_iterations(_trial(8, 1)) == (3 if allowed else 8)
     f = _follower(2)
     f.states = f.states[:2]  # one step: no bend known yet
-    assert f._weighed_iterations(_trial(8, 1)) == 8
+    assert f.weighed_iterations(_trial(8, 1)) == 8
     f = _follower(2)
     f.curve_probe = (None, 0.0)  # no probe to draw the curve with
-    assert f._weighed_iterations(_trial(8, 1)) == 8
+    assert f.weighed_iterations(_trial(8, 1)) == 8
 
 
 
@@ -84,12 +84,12 @@ def test_a_grown_step_is_cut_where_its_secant_turns_from_its_predictor():
     last = _state(0.0, 0.0)
     for turn, bent in ((0.0, False), (0.9, False), (-0.9, False), (1.1, True), (-1.1, True)):
         a = math.radians(135.0) + turn * SETTLING_BEND  # the predictor's direction, turned
-        trial = _Trial(np.array([2.0 * 0.1 * math.cos(a)]), 10.0 * 0.1 * math.sin(a), 3, None)
-        assert f._bends_within(last, trial, t) is bent, turn
-    back = _Trial(np.array([0.1]), -0.5, 3, None)  # straight back along the tangent: no bend
-    assert f._bends_within(last, back, t) is False
+        trial = Trial(np.array([2.0 * 0.1 * math.cos(a)]), 10.0 * 0.1 * math.sin(a), 3, None)
+        assert f.bends_within(last, trial, t) is bent, turn
+    back = Trial(np.array([0.1]), -0.5, 3, None)  # straight back along the tangent: no bend
+    assert f.bends_within(last, back, t) is False
     f.curve_probe = (None, 0.0)
-    assert f._bends_within(last, _Trial(np.array([1.0]), 0.0, 3, None), t) is False
+    assert f.bends_within(last, Trial(np.array([1.0]), 0.0, 3, None), t) is False
 
 
 def test_a_negative_allowance_is_refused():
@@ -134,7 +134,7 @@ def test_an_allowance_of_max_iterations_is_the_controller_without_it():
 def _bent_follower(control="arc-length"):
     """A follower at the retry's state M of a step cut as BENT from ``start``, with the bent
     step's converged state X kept: the path w ↦ λ with M at (−1, 1) (ψ = 1, one DOF u = w)."""
-    f = _Follower.__new__(_Follower)
+    f = PathFollower.__new__(PathFollower)
     f.opt = PathOptions(control=control, settling_allowance=2, until_probe="w",
                         until_value=-10.0)
     f.c, f.dot, f.psi = {"w": np.ones(1)}, np.dot, 1.0
@@ -144,7 +144,7 @@ def _bent_follower(control="arc-length"):
 
 
 def _kept(f, w, lam, start_step=0):
-    x = _Trial(np.array([w]), lam, 9, None)
+    x = Trial(np.array([w]), lam, 9, None)
     f.bent = (start_step, x)
     return x
 
@@ -157,26 +157,26 @@ def test_the_bent_steps_state_is_the_retrys_next_state_within_the_controllers_in
     f = _bent_follower()
     h = 1.0
     x = _kept(f, -2.0, 1.5)  # |X − M| = √1.25 = 1.118 h
-    assert f._bent_half(f.states[-1], h) is x
-    assert f._bent_half(f.states[-1], h) is None  # taken once
+    assert f.bent_half(f.states[-1], h) is x
+    assert f.bent_half(f.states[-1], h) is None  # taken once
     far = math.sqrt(HALF_REACH**2 - 1.0)  # Δλ putting |X − M| at HALF_REACH h
     _kept(f, -2.0, 1.0 + 1.001 * far)
-    assert f._bent_half(f.states[-1], h) is None
+    assert f.bent_half(f.states[-1], h) is None
     _kept(f, -2.0, 1.0 + 0.999 * far)
-    assert f._bent_half(f.states[-1], h) is not None
+    assert f.bent_half(f.states[-1], h) is not None
     _kept(f, -0.5, 1.5)  # Δu = +0.5 against the retry's −1: behind M
-    assert f._bent_half(f.states[-1], h) is None
+    assert f.bent_half(f.states[-1], h) is None
     _kept(f, -2.0, 1.5, start_step=1)  # kept from another start than the retry's
-    assert f._bent_half(f.states[-1], h) is None
+    assert f.bent_half(f.states[-1], h) is None
     f.opt = PathOptions(control="arc-length", settling_allowance=2, until_probe="w",
                         until_value=-1.5)
     _kept(f, -2.0, 1.5)  # the target w = −1.5 lies between M and X: the target logic's
-    assert f._bent_half(f.states[-1], h) is None
+    assert f.bent_half(f.states[-1], h) is None
     f = _bent_follower(control="load")  # the increment is Δλ: 1.2 ≤ 1.25 × 1, 1.3 is not
     _kept(f, -5.0, 2.2)
-    assert f._bent_half(f.states[-1], h) is not None
+    assert f.bent_half(f.states[-1], h) is not None
     _kept(f, -5.0, 2.3)
-    assert f._bent_half(f.states[-1], h) is None
+    assert f.bent_half(f.states[-1], h) is None
 
 
 def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends(monkeypatch):
@@ -185,12 +185,12 @@ def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends
     a step, spends fewer corrector iterations, and ends at the equilibrium the path without
     the kept state (HALF_REACH = 0: never taken) ends at."""
     from sandwich.beam import run
-    from sandwich.solver import path as path_module
+    from sandwich.solver.path import attempts, step_size
     scene = load_scene(SCENES / "paper-fig5-top-debond-40-load-top.toml")
     scene = dataclasses.replace(scene, beam_model=dataclasses.replace(
         scene.beam_model, core=1, core_zones=()))
     spent, taken = [0], []
-    correct, bent_half = path_module.newton_correct, _Follower._bent_half
+    correct, bent_half = attempts.newton_correct, PathFollower.bent_half
 
     def counted(*args, **kwargs):
         res = correct(*args, **kwargs)
@@ -202,10 +202,10 @@ def test_fig5_keeps_its_bent_steps_state_and_ends_where_the_path_without_it_ends
         taken.append(kept)
         return kept
 
-    monkeypatch.setattr(path_module, "newton_correct", counted)
-    monkeypatch.setattr(_Follower, "_bent_half", recorded)
+    monkeypatch.setattr(attempts, "newton_correct", counted)
+    monkeypatch.setattr(PathFollower, "bent_half", recorded)
     kept = run(scene).solution
-    monkeypatch.setattr(path_module, "HALF_REACH", 0.0)
+    monkeypatch.setattr(step_size, "HALF_REACH", 0.0)
     spent.append(0)
     plain = run(scene).solution
     assert kept.converged and plain.converged

@@ -3,7 +3,7 @@
 When the step that crosses a stopping target cannot be shortened onto it by arc-length (the
 shortened arcs' correctors fail), the follower reaches the target by controlling the crossed
 quantity itself from the last state, halving the sub-increment on a failure
-(``_Follower._attempt_target``; needed by the beam's fig. 7 c4 scene at 40 elements). Toy: two
+(``PathFollower.attempt_target``; needed by the beam's fig. 7 c4 scene at 40 elements). Toy: two
 springs in series, the inner one stiffening sharply (a smoothed contact) beyond a gap: under
 control of the loaded DOF, Newton from the linear predictor over the whole distance fails within
 a few iterations while small sub-increments converge. Reference: the closed-form equilibrium
@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from solver_toys import ToySystem
 
 from sandwich.solver import PathOptions
-from sandwich.solver.path import PathState, _Follower
+from sandwich.solver.path import PathFollower, PathState
 
 K1, K2, KC, GAP, S = 1.0, 0.05, 1e3, 1.0, 0.1
 
@@ -50,7 +50,7 @@ def _closed_form(a):
 def _follower(system, max_iterations):
     opts = PathOptions(control="arc-length", until_probe="a", until_value=3.0, tol=1e-10,
                        max_iterations=max_iterations)
-    f = _Follower(system, opts, ["a"], None)
+    f = PathFollower(system, opts, ["a"], None)
     f.psi = 1.0
     f.prev_step = None
     f.sigma = 1.0
@@ -64,9 +64,9 @@ def test_the_target_is_reached_in_substeps_where_one_corrector_fails():
     last = f.states[0]
     t = np.linalg.solve(system.tangent(np.zeros(2)), system.f_ref)
     # one corrector over the whole distance fails (the check that the toy is hard enough) ...
-    assert f._control_to("a", 3.0, last.u, last.load_factor, t) is None
+    assert f.control_to("a", 3.0, last.u, last.load_factor, t) is None
     # ... the sub-incremented control reaches it, on the closed form
-    trial = f._attempt_target("a", 3.0, last, t)
+    trial = f.attempt_target("a", 3.0, last, t)
     assert trial is not None
     lam, b = _closed_form(3.0)
     assert math.isclose(trial.u[0], 3.0, rel_tol=1e-12)
@@ -79,4 +79,4 @@ def test_a_target_beyond_reach_gives_none_not_a_wrong_state():
     f = _follower(system, max_iterations=1)  # one iteration never converges a nonlinear step
     last = f.states[0]
     t = np.linalg.solve(system.tangent(np.zeros(2)), system.f_ref)
-    assert f._attempt_target("a", 3.0, last, t) is None
+    assert f.attempt_target("a", 3.0, last, t) is None
