@@ -5,8 +5,8 @@ auto 1] [--out DIR]``. Writes ``benchmarks/results/beam/corrector_rules.{md,csv}
 replaces them).
 
 Each scene is solved in this process (kernels warm) with the path follower as shipped
-(``sandwich.solver.path.DIVERGENCE_RISES = 2``: a step's corrector whose residual rose twice in
-a row above its first one is abandoned and the step cut; its retries run without the test, and
+(``sandwich.solver.path.follower.DIVERGENCE_RISES = 2``: a step's corrector whose residual rose
+twice in a row above its first one is abandoned and the step cut; its retries run without the test, and
 the rest of the path too once a corrector converged after rising so) and with the test off
 (``DIVERGENCE_RISES = 0``, the path follower before it), one after the other. Every corrector
 run of the path follower is counted through a wrapper of ``newton_correct``: attempts, failed
@@ -20,10 +20,11 @@ import argparse
 import csv
 import os
 
-import sandwich.solver.path as path_module
 from benchmarks.provenance import RESULTS, ROOT, add_out_argument, measured_on
 from sandwich.beam import run
 from sandwich.scene_file import load_scene
+from sandwich.solver.path import attempts as attempts_module
+from sandwich.solver.path import follower as follower_module
 
 OUT = RESULTS / "beam"
 
@@ -31,7 +32,7 @@ OUT = RESULTS / "beam"
 def solve(scene: object, level: str, rises: int) -> tuple[object, dict[str, int]]:
     """One run with ``divergence_rises = rises``; the corrector's counts."""
     options = None if level == "auto" else {"core_level": int(level)}
-    original = path_module.newton_correct
+    original = attempts_module.newton_correct
     counts = {"attempts": 0, "iterations": 0, "failed": 0, "failed_iterations": 0}
 
     def counted(system, u, lam, constraint, settings, *args, **kwargs):
@@ -43,12 +44,12 @@ def solve(scene: object, level: str, rises: int) -> tuple[object, dict[str, int]
             counts["failed_iterations"] += res.iterations
         return res
 
-    shipped = path_module.DIVERGENCE_RISES
-    path_module.newton_correct, path_module.DIVERGENCE_RISES = counted, rises
+    shipped = follower_module.DIVERGENCE_RISES
+    attempts_module.newton_correct, follower_module.DIVERGENCE_RISES = counted, rises
     try:
         return run(scene, model_options=options).solution, counts
     finally:
-        path_module.newton_correct, path_module.DIVERGENCE_RISES = original, shipped
+        attempts_module.newton_correct, follower_module.DIVERGENCE_RISES = original, shipped
 
 
 def main() -> None:
