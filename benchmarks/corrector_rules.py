@@ -6,8 +6,8 @@ replaces them).
 
 Each scene is solved in this process (kernels warm) with the path follower as shipped
 (``sandwich.solver.path.follower.DIVERGENCE_RISES = 2``: a step's corrector whose residual rose
-twice in a row above its first one is abandoned and the step cut; its retries run without the test, and
-the rest of the path too once a corrector converged after rising so) and with the test off
+twice in a row above its first one is abandoned and the step cut; its retries run without the
+test, and the rest of the path too once a corrector converged after rising so) and with the test off
 (``DIVERGENCE_RISES = 0``, the path follower before it), one after the other. Every corrector
 run of the path follower is counted through a wrapper of ``newton_correct``: attempts, failed
 attempts and the iterations they spent. Recorded: solve wall (``Solution.wall_seconds``),
