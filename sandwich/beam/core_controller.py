@@ -1,9 +1,10 @@
-"""``auto`` core levels along a nonlinear path: rerun at raised levels while the end load moves.
+"""``auto`` core levels along a nonlinear path: rerun at raised levels while the end moves.
 
 The linear step chose the first levels (:mod:`sandwich.beam.core_choice`). After the path at
 those levels, the last converged state says where the core wants more levels
 (:func:`sandwich.beam.core_levels.state_shares`); the levels are raised there and over every
-debonded stretch and load patch, and the change of the end load is the estimate. Each raise is
+debonded stretch and load patch, and the change of the path's end is the estimate (the end load
+at a probe target, the probes at a load target: :func:`end_change`). Each raise is
 first tried on the checked pass's end state alone (:meth:`CoreController.end_state`), and the
 path is followed at the levels the checks end at; reruns continue while the estimate exceeds the
 tolerance, at most ``rechecks`` times (:class:`AutoSettings`). :class:`CoreController` holds
@@ -145,6 +146,7 @@ class CoreController:
         self.capped = False
         self.stopped_rerun = ""
         self.previous: float | None = None  # end load at the levels the current ones raised
+        self.previous_probes: dict[str, float] = {}  # and its probes (load targets: the answer)
         self.kept: CheckedPass | None = None  # the last pass that reached the target
         self.raises = 0
         self.checks = self.settings.end_state_checks and scene.analysis.until_probe is not None
@@ -184,7 +186,7 @@ class CoreController:
                 kept, choice.levels, choice.estimate = self.kept
                 return kept
             if self.previous is not None:  # the change the last raise made is the estimate
-                choice.estimate = (abs(last.load_factor - self.previous) / abs(last.load_factor)
+                choice.estimate = (end_change(a, last, self.previous, self.previous_probes)
                                    if path.converged else None)
             if self.below_estimate is not None:  # confirmed: the levels below a check within it
                 choice.estimate = self.below_estimate
@@ -204,7 +206,7 @@ class CoreController:
                 self.capped = True
                 return path
             self.raises += 1
-            self.previous = last.load_factor
+            self.previous, self.previous_probes = last.load_factor, dict(last.probes)
             choice.levels = levels
             if self.checks and _at_probe_target(a, last):
                 # Before following the path at the raised levels, continue its end state into
@@ -386,6 +388,24 @@ class CoreController:
         return dataclasses.replace(level_1, message=level_1.message + (
             f"; WARNING: with auto core levels the path stopped ({stopped}); this is the "
             "paper's element (core level 1), its error not estimated"))
+
+
+def end_change(analysis: object, state: ConvergedState, load_factor: float,
+               probes: dict[str, float]) -> float | None:
+    """The relative change of a path's end between two passes: what the scene asks for there.
+
+    At a probe target the load factor is the answer (its relative change); at a load target the
+    load is fixed and the probes are the answer: their largest change relative to the largest
+    probe magnitude (a probe that barely moves is not divided by its own near-zero value).
+    None where nothing can be compared (no probe moved).
+    """
+    if analysis.until_probe is not None and _at_probe_target(analysis, state):
+        return abs(state.load_factor - load_factor) / abs(state.load_factor)
+    scale = max((abs(v) for v in state.probes.values()), default=0.0)
+    common = [n for n in state.probes if n in probes]
+    if scale == 0.0 or not common:
+        return None
+    return max(abs(state.probes[n] - probes[n]) for n in common) / scale
 
 
 def _at_probe_target(analysis: object, state: ConvergedState) -> bool:
