@@ -161,9 +161,9 @@ class CoreController:
         """
         path = self.follow()
         if self.stopped_rerun:
-            path = dataclasses.replace(path, message=path.message + (
-                f"; WARNING: the rerun with raised core levels stopped ({self.stopped_rerun}); "
-                "this is the pass it was checking"))
+            path = dataclasses.replace(path, warnings=[*path.warnings, (
+                f"the rerun with raised core levels stopped ({self.stopped_rerun}); "
+                "this is the pass it was checking")])
         return self.fallback(path)
 
     def follow(self) -> PathPass:
@@ -385,9 +385,9 @@ class CoreController:
                               "elements_per_level": level_counts(choice.levels),
                               "load_factor": level_1.last.load_factor, "reached": True,
                               "estimate": None})
-        return dataclasses.replace(level_1, message=level_1.message + (
-            f"; WARNING: with auto core levels the path stopped ({stopped}); this is the "
-            "paper's element (core level 1), its error not estimated"))
+        return dataclasses.replace(level_1, warnings=[*level_1.warnings, (
+            f"with auto core levels the path stopped ({stopped}); this is the "
+            "paper's element (core level 1), its error not estimated")])
 
 
 def end_change(analysis: object, state: ConvergedState, load_factor: float,

@@ -44,6 +44,7 @@ class PathPass:
     limit_points: list[LimitPoint]
     # the penalties the reruns raised from (the first: the model's own), empty without rerun
     penalties_raised: list[float] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # the path follower's and auto's
 
     @property
     def last(self) -> ConvergedState:
@@ -93,7 +94,7 @@ def follow(
     states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes),
                              dict(s.extra)) for s in result.states]
     return PathPass(model, states, result.message, result.reached_target,
-                    list(result.limit_points))
+                    list(result.limit_points), warnings=list(result.warnings))
 
 
 def follow_penalised(

@@ -43,7 +43,7 @@ def beam_solution(
     The history's contact and energy release rate columns are the path's where it kept them
     (:meth:`~sandwich.beam.model.BeamModel.state_columns`), else evaluated (a linear analysis
     has no contact columns: zeros); profiles and field frames every ``profile_every`` steps and
-    at the last state; a penetration beyond the model's bound is a WARNING of the message.
+    at the last state; a penetration beyond the model's bound is one of its warnings.
     """
     history = []
     max_pen = max_slide = 0.0
@@ -67,13 +67,12 @@ def beam_solution(
                 for s in chosen]
     fields = [_field_frame(model, s, nonlinear) for s in chosen]
     bound = model.penetration_bound()
-    if max_pen > bound:
-        message += (f"; WARNING: contact penetration {max_pen:.3g} mm exceeds "
-                    f"{bound:.3g} mm (raise beam_model.contact_penalty)")
+    warnings = [f"contact penetration {max_pen:.3g} mm exceeds {bound:.3g} mm (raise "
+                "beam_model.contact_penalty)"] if max_pen > bound else []
     return Solution(
         model="beam", scene=scene.name, history=history, profiles=profiles, converged=converged,
         message=message, limit_points=limit_points, wall_seconds=0.0, dofs=model.size,
-        fields=fields,
+        fields=fields, warnings=warnings,
         extra={
             "elements": model.mesh.n_elements,
             "nodes": model.mesh.n_nodes,

@@ -78,6 +78,7 @@ def run(
     nonlinear = a.kind == "nonlinear"
     limit_points = []
     raised: list[float] = []
+    warnings: list[str] = []
     capped = False
     if not nonlinear:
         model = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene),
@@ -94,6 +95,7 @@ def run(
                                     progress)
         model, states, message = path.model, path.states, path.message
         converged, limit_points, raised = path.converged, path.limit_points, path.penalties_raised
+        warnings += path.warnings
         if raised:
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
@@ -104,12 +106,13 @@ def run(
                 f"{100 * choice.estimate:.2g} % exceeds the tolerance "
                 f"{100 * float(bm.tolerance):.2g} %")
         reruns = f", {path_passes(choice) - 1} rerun(s) of the path" if nonlinear else ""
-        message += (f"; WARNING: the core's estimated error {said} (max_core_level "
-                    f"{bm.max_core_level}{reruns})")
+        warnings.append(f"the core's estimated error {said} (max_core_level "
+                        f"{bm.max_core_level}{reruns})")
     if capped:
         message += (f"; the debond and load zones are at max_core_level {bm.max_core_level}: "
                     "what a further raise there would change is not measured")
     solution = beam_solution(scene, model, states, nonlinear, converged, message, limit_points)
+    solution.warnings[:0] = warnings  # the path's and auto's first, then the solution's own
     solution.extra["contact_penalty_reruns"] = len(raised)
     solution.extra.update(growth_summary(scene, solution))
     if level_warning(model, beam_tips(scene, model)):

@@ -58,8 +58,9 @@ def scene_row(folder: Path, trust: Mapping[str, str] | None = None) -> dict[str,
         row[f"{model}_wall_s"] = s["wall_seconds"]
         lims = s.get("limit_loads") or []
         row[f"{model}_first_max"] = lims[0]["load_factor"] if lims else None
-        row[f"{model}_message"] = s["message"] if (not s["converged"] or "WARNING" in
-                                                   (s["message"] or "")) else ""
+        said = [s["message"]] if not s["converged"] else []
+        said += [f"WARNING: {w}" for w in s.get("warnings") or []]
+        row[f"{model}_message"] = "; ".join(said)
         try:
             sol = load_result(folder / model, fields=False)
         except Exception as exc:  # a missing/failed model: the row says why

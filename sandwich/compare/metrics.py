@@ -99,6 +99,7 @@ class ModelSummary:
     limit_loads: list[LimitLoad]  # detected on the history
     reported_limit_loads: list[LimitLoad]  # as the model reported them (kind "max")
     critical_loads: list[CriticalLoad] = field(default_factory=list)  # maxima and bifurcations
+    warnings: list[str] = field(default_factory=list)  # the model's, as its summary.json has them
 
     def first_critical(self, kind: str) -> CriticalLoad | None:
         """The first reported critical point of ``kind`` ("max" or "bifurcation") on the path."""
@@ -182,7 +183,7 @@ def summarize(run: ModelRun) -> ModelSummary:
                 if lp.kind in CRITICAL_KINDS and math.isfinite(lp.load_factor)]
     return ModelSummary(run.model, run.origin, run.reason, s.converged, s.message,
                         len(s.history), _finite(s.final_load_factor), _finite(s.wall_seconds),
-                        s.dofs, detected, reported, critical)
+                        s.dofs, detected, reported, critical, list(s.warnings))
 
 
 def crushed_note(model: str, sol: Solution) -> str:

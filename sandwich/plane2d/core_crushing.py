@@ -174,7 +174,7 @@ def crushing_warning(first: CoreState, step: int, load_factor: float,
         return ""
     when = (f"in step {step} (λ {before[1]:.6g} → {load_factor:.6g})" if before is not None
             else f"at step {step} (λ = {load_factor:.6g})")
-    return (f"WARNING: the core crushed as a material {when} at x = {first.x:.4g}, "
+    return (f"the core crushed as a material {when} at x = {first.x:.4g}, "
             f"z = {first.z:.4g} mm (the Green-strain law lost ellipticity there, smallest "
             f"principal stretch {first.min_stretch:.3g}); a load maximum "
             "in or after that step may be this material limit of the St Venant-Kirchhoff core "

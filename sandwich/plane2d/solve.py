@@ -111,6 +111,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
             record(PathState(step, u, lf, 0 if step == 0 else 1,
                              {n: system.dot(system.probe_vector(n), u) for n in names}, None))
         converged, message = True, f"linear solution scaled to λ = {lam:.6g}"
+        warnings: list[str] = []
     else:
         # Newton cannot get the residual below the round-off of its own evaluation: ask for the
         # scene's tolerance or that bound, whichever is larger (reported in the summary)
@@ -119,7 +120,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         options = PathOptions.from_analysis(a, tol=newton_tol)
         result = follow_path(system, options, names, progress=record)
         converged, message = result.reached_target, result.message
-        limit_points = result.limit_points
+        limit_points, warnings = result.limit_points, list(result.warnings)
 
     profiles = _profiles(model, scene, states)
     penetration = max((r.extra["max_penetration"] for r in rows), default=0.0)
@@ -158,12 +159,13 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         if crushed:
             step, lf, core = core_states[crushed[0]]
             before = core_states[crushed[0] - 1][:2] if crushed[0] > 0 else None
-            message = f"{message}; {crushing_warning(core, step, lf, before)}"
+            warnings.append(crushing_warning(core, step, lf, before))
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)
     solution = Solution(MODEL_NAME, scene.name, rows, profiles, bool(converged), message,
-                        limit_points, time.perf_counter() - t0, int(system.global_size), extra)
+                        limit_points, time.perf_counter() - t0, int(system.global_size), extra,
+                        warnings=warnings)
     if states:  # the last state for ParaView (VTU + PVD), gathered to every rank
         from sandwich.plane2d.fields import field_frame
 

@@ -27,7 +27,7 @@ from sandwich.results.vtu import read_pvd, read_vtu
 RESULT_FILES = ("history.csv", "profiles.csv", "summary.json")
 FIELDS_COLLECTION = "fields.pvd"
 _SUMMARY_KEYS = {"model", "scene", "converged", "message", "steps", "final_load_factor",
-                 "limit_points", "wall_seconds", "dofs"}
+                 "limit_points", "wall_seconds", "dofs", "warnings"}
 
 
 class ResultMissing(FileNotFoundError):
@@ -141,6 +141,7 @@ def load_result(folder: str | Path, *, fields: bool = True) -> Solution:
         dofs=int(summary.get("dofs", 0) or 0),
         extra={k: v for k, v in summary.items() if k not in _SUMMARY_KEYS},
         fields=read_field_frames(folder) if fields else [],
+        warnings=[str(w) for w in summary.get("warnings", [])],
     )
 
 

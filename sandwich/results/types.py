@@ -91,6 +91,9 @@ class Solution:
     dofs: int
     extra: dict[str, object] = field(default_factory=dict)
     fields: list[FieldFrame] = field(default_factory=list)
+    # what a user must know about the answer besides why the run ended (``message``): an
+    # estimate above its tolerance, a rerun that stopped, a core that crushed, …; one sentence each
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def final_load_factor(self) -> float:

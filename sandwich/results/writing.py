@@ -121,6 +121,7 @@ def summary_dict(solution: Solution) -> dict[str, object]:
         "scene": solution.scene,
         "converged": solution.converged,
         "message": solution.message,
+        "warnings": list(solution.warnings),
         "steps": len(solution.history),
         "final_load_factor": _finite(solution.final_load_factor),
         "limit_points": [

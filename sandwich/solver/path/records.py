@@ -47,6 +47,7 @@ class PathResult:
     reached_target: bool
     message: str
     limit_points: list[LimitPoint] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # one sentence each, besides the message
 
 
 @dataclass

@@ -145,17 +145,19 @@ class FollowerState:
     def finish(self, reached: bool, message: str) -> PathResult:
         """The :class:`~.records.PathResult` of the states so far, with ``message`` completed."""
         opt = self.opt
+        warnings = []
         if (opt.until_probe is not None and opt.until_load_factor is None and self.states
                 and self.states[-1].load_factor < 0
                 and not any(s.load_factor > 0 for s in self.states)):
             # The probe's target lies the other way from where the loads push it: the follower
             # heads for it with λ < 0, which a user rarely means (a sign slip in until or force).
             # (Not said of a path that came back through zero load: no sign slip sends it there.)
-            message += (f"; WARNING: {opt.until_probe} heads for {opt.until_value:g} only "
-                        "with λ < 0: every load's force is reversed (check the sign of "
-                        "analysis.until's value and of the loads' force)")
+            warnings.append(f"{opt.until_probe} heads for {opt.until_value:g} only with λ < 0: "
+                            "every load's force is reversed (check the sign of "
+                            "analysis.until's value and of the loads' force)")
         if self.rescues:
             message += (f" ({len(self.rescues)} step(s) taken under control of "
                         f"{self.opt.until_probe} where the arc collapsed at a critical point: "
                         f"step(s) {', '.join(map(str, self.rescues))})")
-        return PathResult(self.states, reached, message, find_limit_points(self.states))
+        return PathResult(self.states, reached, message, find_limit_points(self.states),
+                          warnings)
