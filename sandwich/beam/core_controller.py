@@ -34,6 +34,7 @@ from sandwich.beam.fracture import beam_tips, uniform_tip_levels
 from sandwich.beam.model import BeamModel
 from sandwich.beam.path_pass import PathPass, follow_penalised, max_penetration
 from sandwich.beam.states import ConvergedState
+from sandwich.results import PathNote
 
 # A rerun may take at most RERUN_STEP_FACTOR times the steps of the pass it checks (at least
 # RERUN_MIN_STEPS): a raised model that needs far more steps has met a path the checked pass did
@@ -70,21 +71,6 @@ class AutoSettings:
     end_state_backtracks: int = END_STATE_BACKTRACKS
     below_fraction: float = BELOW_FRACTION
     below_factor: float = BELOW_FACTOR
-
-
-@dataclass(frozen=True)
-class CoreRecheck:
-    """Progress event: the path is rerun with raised core levels (the bar restarts)."""
-
-    elements_per_level: dict[str, int]
-    step: int = 0
-    load_factor: float = 0.0
-
-    @property
-    def message(self) -> str:
-        """What a user is told."""
-        return ("checking the core levels: rerunning the path with elements per core level "
-                f"{self.elements_per_level}")
 
 
 class CheckedPass(NamedTuple):
@@ -228,7 +214,8 @@ class CoreController:
                     self.pending = PendingCheck(checked_load, start)
                     self.below_estimate = below
             if self.progress is not None:
-                self.progress(CoreRecheck(level_counts(choice.levels)))
+                self.progress(PathNote("checking the core levels: rerunning the path with "
+                                       f"elements per core level {level_counts(choice.levels)}"))
 
     def _rerun_budget(self) -> int | None:
         """The steps a rerun may take: a multiple of the checked pass's (None: the first pass)."""

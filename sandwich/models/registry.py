@@ -17,10 +17,10 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from sandwich.results import RunIdentity, Solution, scene_digest, source_digest
+from sandwich.results import ProgressItem, RunIdentity, Solution, scene_digest, source_digest
 from sandwich.scene import Scene
 
-StateCallback = Callable[[object], None]
+StateCallback = Callable[[ProgressItem], None]  # each converged state, or a PathNote
 
 
 def _solve_beam(scene: Scene, progress: StateCallback | None = None) -> Solution:

@@ -24,6 +24,8 @@ from sandwich.fracture import growth_onset, missing_releases
 from sandwich.models.registry import get_model
 from sandwich.results import (
     OutputError,
+    PathNote,
+    ProgressItem,
     RunIdentity,
     Solution,
     StepRecord,
@@ -150,17 +152,12 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
     solve = solver or spec.solve
     streamed: list[StepRecord] = []
 
-    def on_state(state: object) -> None:
-        if isinstance(state, dict):  # information from a solver, not a path state
+    def on_state(item: ProgressItem) -> None:
+        if isinstance(item, PathNote):  # the path starts again: its states supersede these
+            streamed.clear()
+            say(ProgressEvent(model, "note", message=item.message))
             return
-        if getattr(state, "probes", None) is None:  # a note, e.g. the path is rerun
-            note = str(getattr(state, "message", ""))
-            streamed.clear()  # a rerun starts the path again: its states supersede these
-            say(ProgressEvent(model, "note", message=note))
-            return
-        rec = StepRecord(int(state.step), float(state.load_factor),  # type: ignore[attr-defined]
-                         dict(state.probes), int(getattr(state, "iterations", 0)),  # type: ignore[attr-defined]
-                         dict(getattr(state, "extra", None) or {}))  # e.g. G at the tips
+        rec = StepRecord.of(item)  # the state's columns kept, e.g. G at the tips
         streamed.append(rec)
         say(ProgressEvent(model, "step", step=rec.step, load_factor=rec.load_factor,
                           probes=rec.probes))

@@ -20,7 +20,9 @@ from sandwich.results.types import (
     PROFILE_COLUMNS,
     FieldFrame,
     LimitPoint,
+    PathNote,
     Profile,
+    ProgressItem,
     Solution,
     StepRecord,
 )
@@ -35,7 +37,7 @@ from sandwich.results.writing import (
 )
 
 __all__ = ["FIELDS_COLLECTION", "PROFILE_COLUMNS", "RESULT_FILES", "FieldFrame", "LimitPoint",
-           "OutputError", "Profile", "ResultMissing", "RunIdentity", "Solution", "StepRecord",
+           "OutputError", "PathNote", "Profile", "ProgressItem", "ResultMissing", "RunIdentity", "Solution", "StepRecord",
            "atomic_write_text", "check_output_folder", "history_csv", "load_result",
            "profiles_csv", "read_field_frames", "scene_digest", "source_digest", "summary_dict",
            "write_solution"]

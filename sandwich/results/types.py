@@ -8,6 +8,7 @@ frames (:class:`FieldFrame`, the one field type both models fill).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol, Union
 
 import numpy as np
 
@@ -23,6 +24,36 @@ class StepRecord:
     probes: dict[str, float]
     iterations: int
     extra: dict[str, float] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, state: StateLike) -> StepRecord:
+        """The record of a solver's converged state (its solution vector left behind)."""
+        return cls(int(state.step), float(state.load_factor), dict(state.probes),
+                   int(state.iterations), dict(state.extra or {}))
+
+
+class StateLike(Protocol):
+    """What a model streams for each converged state (the solver's ``PathState`` is one)."""
+
+    step: int
+    load_factor: float
+    probes: dict[str, float]
+    iterations: int
+    extra: dict[str, float | None]
+
+
+@dataclass(frozen=True)
+class PathNote:
+    """What a model tells while it solves, besides its states: the path starts again.
+
+    The one other event a model's ``progress`` callback receives; the states streamed before
+    it are superseded (a rerun at raised core levels follows the path from its start).
+    """
+
+    message: str
+
+
+ProgressItem = Union[StateLike, PathNote]  # noqa: UP007 - a runtime alias of a Protocol
 
 
 @dataclass

@@ -8,7 +8,6 @@ and then falls. The "beam" is the same analytic path scaled by (1 + ε), sampled
 import math
 import shutil
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -69,8 +68,7 @@ def make_solution(model: str, *, eps: float = 0.0, n_steps: int = 150, n_x: int 
                          iterations=3 + i % 2, extra={"cuts": float(i % 3 == 0)})
         history.append(rec)
         if progress is not None:
-            progress(SimpleNamespace(step=rec.step, load_factor=rec.load_factor,
-                                     probes=rec.probes))
+            progress(rec)
     profiles = []
     for k in profile_steps:
         cols = profile_columns(n_x, history[k].probes["w_top_mid"], 1 + eps)

@@ -129,14 +129,14 @@ def test_a_full_disk_keeps_the_previous_result_and_says_so(tmp_path, scene_file,
 
 def test_a_models_note_restarts_the_streamed_path(tmp_path, scene_file, synth, monkeypatch,
                                                   capsys):
-    from types import SimpleNamespace
+    from sandwich.results import PathNote
 
     history = synth.make_solution("2d", n_steps=8).history
 
     def rerun_then_interrupted(scene, progress=None):
         for rec in history[:3]:
             progress(rec)
-        progress(SimpleNamespace(step=0, load_factor=0.0, message="rerunning the path"))
+        progress(PathNote("rerunning the path"))
         for rec in history[:2]:
             progress(rec)
         raise KeyboardInterrupt

@@ -142,7 +142,6 @@ def test_a_case_over_the_wall_time_cap_keeps_its_converged_steps(tmp_path, monke
     """The study's ``timeout``: a case past the cap at a converged step is recorded as timeout,
     its converged steps written (history only, never reused); the other case is solved."""
     import dataclasses
-    from types import SimpleNamespace
 
     from distributed import Client, LocalCluster
 
@@ -158,8 +157,8 @@ def test_a_case_over_the_wall_time_cap_keeps_its_converged_steps(tmp_path, monke
             return Solution("beam", scene.name, hist, [], True, "reached", [], 0.01, 10)
         for i in range(1, 40):  # a converged state every 0.2 s, far past the 1-s cap
             time.sleep(0.2)
-            progress(SimpleNamespace(step=i, load_factor=10.0 * i, iterations=3,
-                                     probes={"w_top_mid": -0.1 * i, "w_bottom_mid": -0.1 * i}))
+            progress(StepRecord(i, 10.0 * i, {"w_top_mid": -0.1 * i, "w_bottom_mid": -0.1 * i},
+                                3))
         raise AssertionError("the cap did not stop the case")
 
     monkeypatch.setitem(registry.MODELS, "beam", dataclasses.replace(spec, solve=slow))
