@@ -33,8 +33,8 @@ from sandwich.beam.core_levels import (
 from sandwich.beam.fracture import beam_tips, uniform_tip_levels
 from sandwich.beam.model import BeamModel
 from sandwich.beam.path_pass import PathPass, follow_penalised, max_penetration
-from sandwich.beam.states import ConvergedState
 from sandwich.results import PathNote
+from sandwich.solver import PathState
 
 # A rerun may take at most RERUN_STEP_FACTOR times the steps of the pass it checks (at least
 # RERUN_MIN_STEPS): a raised model that needs far more steps has met a path the checked pass did
@@ -253,7 +253,7 @@ class CoreController:
         self.choice.levels = first
         return True
 
-    def _raised_levels(self, model: BeamModel, last: ConvergedState, levels: np.ndarray,
+    def _raised_levels(self, model: BeamModel, last: PathState, levels: np.ndarray,
                        top: int) -> np.ndarray | None:
         """The levels a rerun checks after ``last``, or None where the zones are at the cap.
 
@@ -319,8 +319,8 @@ class CoreController:
                 return EndStateChecks(found, True, None)
             cur, previous, levels, raises = up, state.load_factor, higher, raises + 1
 
-    def end_state(self, model: BeamModel, state: ConvergedState,
-                  levels: np.ndarray) -> tuple[BeamModel, ConvergedState] | None:
+    def end_state(self, model: BeamModel, state: PathState,
+                  levels: np.ndarray) -> tuple[BeamModel, PathState] | None:
         """``state`` (at the until target) continued into the model at ``levels``, or None.
 
         The state is carried over (new enrichment amplitudes zero) and re-equilibrated at the
@@ -349,8 +349,8 @@ class CoreController:
         if max_penetration(up, [res.u]) > up.penetration_bound():
             return None
         probes = {n: float(np.asarray(up.probe_vector(n)) @ res.u) for n in up.probe_rows}
-        return up, ConvergedState(state.step, float(res.load_factor), res.u, res.iterations,
-                                  probes)
+        return up, PathState(state.step, res.u, float(res.load_factor), res.iterations, probes,
+                             None)
 
     def fallback(self, path: PathPass) -> PathPass:
         """``path``, or the path at level 1 where the one at the chosen levels stopped short.
@@ -377,7 +377,7 @@ class CoreController:
             "paper's element (core level 1), its error not estimated")])
 
 
-def end_change(analysis: object, state: ConvergedState, load_factor: float,
+def end_change(analysis: object, state: PathState, load_factor: float,
                probes: dict[str, float]) -> float | None:
     """The relative change of a path's end between two passes: what the scene asks for there.
 
@@ -395,7 +395,7 @@ def end_change(analysis: object, state: ConvergedState, load_factor: float,
     return max(abs(state.probes[n] - probes[n]) for n in common) / scale
 
 
-def _at_probe_target(analysis: object, state: ConvergedState) -> bool:
+def _at_probe_target(analysis: object, state: PathState) -> bool:
     """Whether ``state`` ended the path at the until probe's target (not at a load target)."""
     target = float(analysis.until_value)
     return abs(state.probes[analysis.until_probe] - target) <= 1e-4 * max(abs(target), 1e-12)

@@ -15,8 +15,8 @@ import numpy as np
 
 from sandwich.beam.build import build_model, scene_gauss_orders
 from sandwich.beam.model import BeamModel
-from sandwich.beam.states import ConvergedState
 from sandwich.results import LimitPoint
+from sandwich.solver import PathState
 
 MIN_INCREMENT_PER_SMOOTHING = 0.01  # default path increment floor / contact smoothing width s
 # Newton iterations per step at which the path follower keeps the increment (its default is 5).
@@ -38,7 +38,7 @@ class PathPass:
     """The path followed once at fixed core levels (its penalty reruns included)."""
 
     model: BeamModel  # the model of the last attempt
-    states: list[ConvergedState]
+    states: list[PathState]
     message: str
     converged: bool  # the target was reached
     limit_points: list[LimitPoint]
@@ -47,7 +47,7 @@ class PathPass:
     warnings: list[str] = field(default_factory=list)  # the path follower's and auto's
 
     @property
-    def last(self) -> ConvergedState:
+    def last(self) -> PathState:
         """The last converged state."""
         return self.states[-1]
 
@@ -91,8 +91,7 @@ def follow(
                                         settling_allowance=scene.beam_model.settling_allowance,
                                         **caps)
     result = follow_path(model, options, list(model.probe_rows), progress)
-    states = [ConvergedState(s.step, s.load_factor, s.u, s.iterations, dict(s.probes),
-                             dict(s.extra)) for s in result.states]
+    states = list(result.states)
     return PathPass(model, states, result.message, result.reached_target,
                     list(result.limit_points), warnings=list(result.warnings))
 
@@ -126,7 +125,7 @@ def max_penetration(model: BeamModel, displacements: list[np.ndarray]) -> float:
                 for c in model.contact_summary(u).values()), default=0.0)
 
 
-def states_penetration(model: BeamModel, states: list[ConvergedState]) -> float:
+def states_penetration(model: BeamModel, states: list[PathState]) -> float:
     """Deepest contact penetration (mm) over ``states``, from their path columns if kept."""
     return max((s.extra["max_penetration"] if "max_penetration" in s.extra
                 else max_penetration(model, [s.u]) for s in states), default=0.0)

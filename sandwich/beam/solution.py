@@ -13,11 +13,11 @@ from sandwich.beam.contact_summary import CONTACT_COLUMNS, contact_columns
 from sandwich.beam.fields import profile_columns, section_fields
 from sandwich.beam.fracture import beam_tips, column_names, release_columns
 from sandwich.beam.model import BeamModel
-from sandwich.beam.states import ConvergedState
 from sandwich.results import FieldFrame, LimitPoint, Profile, Solution, StepRecord
+from sandwich.solver import PathState
 
 
-def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> FieldFrame:
+def _field_frame(model: BeamModel, state: PathState, nonlinear: bool) -> FieldFrame:
     """Faces and core of ``state`` on one quad grid (``section_fields``) as a ParaView frame.
 
     Point data: σ_x, σ_z, τ, von Mises (MPa, 2nd Piola-Kirchhoff); cell data: ``region``
@@ -35,7 +35,7 @@ def _field_frame(model: BeamModel, state: ConvergedState, nonlinear: bool) -> Fi
 
 
 def beam_solution(
-    scene: object, model: BeamModel, states: list[ConvergedState], nonlinear: bool,
+    scene: object, model: BeamModel, states: list[PathState], nonlinear: bool,
     converged: bool, message: str, limit_points: list[LimitPoint],
 ) -> Solution:
     """The common :class:`~sandwich.results.Solution` of ``states`` (model "beam").

@@ -24,9 +24,9 @@ from sandwich.beam.linear_step import linear_solution, toward_target
 from sandwich.beam.model import BeamModel
 from sandwich.beam.path_pass import follow_penalised
 from sandwich.beam.solution import beam_solution, growth_summary
-from sandwich.beam.states import ConvergedState
 from sandwich.results import Solution
 from sandwich.scene import Scene
+from sandwich.solver import PathState
 
 
 @dataclass
@@ -35,7 +35,7 @@ class BeamRun:
 
     solution: Solution
     model: BeamModel
-    states: list[ConvergedState]
+    states: list[PathState]
     nonlinear: bool
 
 
@@ -130,12 +130,12 @@ def run(
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
 
 
-def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState], str]:
+def _linear_states(model: BeamModel, scene: object) -> tuple[list[PathState], str]:
     """The linear analysis: the unloaded state and the linear step at the scene's target."""
     a = scene.analysis
     names = list(model.probe_rows)
     probe = {n: model.probe_vector(n) for n in names}
-    zero = ConvergedState(0, 0.0, np.zeros(model.size), 0, {n: 0.0 for n in names})
+    zero = PathState(0, np.zeros(model.size), 0.0, 0, {n: 0.0 for n in names}, None)
     if a.until_probe is not None:
         sign, u1, passes, _ = toward_target(model, a.until_probe, a.until_value)
         λ = sign * a.until_value / float(probe[a.until_probe] @ u1)
@@ -145,6 +145,6 @@ def _linear_states(model: BeamModel, scene: object) -> tuple[list[ConvergedState
         λ = a.until_load_factor if a.until_load_factor is not None else 1.0
         u, passes = linear_solution(model, λ)
         message = f"linear solution at load factor {λ:g}"
-    state = ConvergedState(1, float(λ), u, passes, {n: float(probe[n] @ u) for n in names})
+    state = PathState(1, u, float(λ), passes, {n: float(probe[n] @ u) for n in names}, None)
     model.commit(u, λ)
     return [zero, state], message

@@ -13,15 +13,15 @@ import pytest
 
 from sandwich.beam import run
 from sandwich.beam.core_controller import end_change
-from sandwich.beam.states import ConvergedState
 from sandwich.scene import Analysis
 from sandwich.scene_file import load_scene
+from sandwich.solver import PathState
 
 FIG4 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig4-bonded-3pb.toml"
 
 
 def _state(lam, probes):
-    return ConvergedState(3, lam, None, 4, probes)
+    return PathState(3, None, lam, 4, probes, None)
 
 
 def test_at_a_load_target_the_probes_change_is_the_estimate():
