@@ -41,6 +41,7 @@ def _workload() -> None:
     from sandwich.beam.solve import scene_model_options
     from sandwich.scene_file import load_scene
     from sandwich.solver import envelope
+    from sandwich.solver.envelope import structure as envelope_structure
 
     scenes = ROOT / "scenes"
     fig5 = load_scene(scenes / "paper-fig5-top-debond-40-load-top.toml")
@@ -64,16 +65,16 @@ def _workload() -> None:
     # the row-envelope storage and the blocks output of the layer kernels
     model = build_model(fig5, elements=30, core_level=2, **scene_model_options(fig5))
     Kt = model.tangent(np.full(model.size, 1e-3))
-    saved = envelope.COLUMN_ADVANTAGE
-    envelope.COLUMN_ADVANTAGE = 0.0
+    saved = envelope_structure.COLUMN_ADVANTAGE  # read there when a structure is built
+    envelope_structure.COLUMN_ADVANTAGE = 0.0
     try:
         envelope.factorize_envelope(Kt).solve(np.ones((model.size, 2)))
         envelope.factorize_envelope(Kt).solve(np.ones(model.size))
     finally:
-        envelope.COLUMN_ADVANTAGE = saved
+        envelope_structure.COLUMN_ADVANTAGE = saved
     # a widening (contact pairs that come into contact along a path): a structure of the
     # tangent's values with its couplings beyond 5 columns stored as zeros, then the tangent
-    # itself, whose values spill out of that envelope (envelope._pattern_union)
+    # itself, whose values spill out of that envelope (envelope.patterns.pattern_union)
     B = Kt.tocsr(copy=True)
     far = np.abs(B.indices - np.repeat(np.arange(B.shape[0]), np.diff(B.indptr))) > 5
     B.data[far] = 0.0

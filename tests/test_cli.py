@@ -111,7 +111,7 @@ def test_library_log_lines_are_held_back_unless_verbose():
 def test_warnings_before_a_solve(tmp_path):
     import dataclasses
 
-    from sandwich.cli.commands import warnings_before_solve
+    from sandwich.cli.scene_commands import warnings_before_solve
     from sandwich.scene import Analysis, Load
     from sandwich.scene_file import load_scene
 
@@ -133,7 +133,7 @@ def test_an_internal_error_names_its_crash_log_and_leaves_the_current_folder_cle
     def broken(args):
         raise RuntimeError("a bug")
 
-    monkeypatch.setattr(commands, "cmd_validate", broken)
+    monkeypatch.setattr(commands, "cmd_validate", broken)  # what the parser runs for validate
     work = tmp_path / "cwd"
     work.mkdir()
     monkeypatch.chdir(work)

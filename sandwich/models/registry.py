@@ -81,7 +81,7 @@ class ModelSpec:
 
 
 # The contract every model is built on: paths under the project root, for the code digest.
-CONTRACT = ("sandwich/__init__.py", "sandwich/scene.py", "sandwich/scene_checks.py",
+CONTRACT = ("sandwich/__init__.py", "sandwich/scene.py", "sandwich/scene_checks",
             "sandwich/scene_file.py", "sandwich/fracture.py", "sandwich/results", "sandwich/solver")
 
 MODELS: dict[str, ModelSpec] = {

@@ -42,13 +42,15 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["Kernel", "cache_directory", "kernel_backend", "kernels", "njit"]
+__all__ = ["Kernel", "aot_exports", "argument_matcher", "cache_directory", "kernel_backend",
+           "kernels", "njit", "writable"]
 
 _HERE = Path(__file__).resolve()
-_SOURCE_DIRS = (_HERE.parent, _HERE.parents[1] / "beam")  # the kernels' source dirs
+# the kernels' source dirs
+_SOURCE_DIRS = (_HERE.parent, _HERE.parent / "envelope", _HERE.parents[1] / "beam")
 
 
-def _writable(path: Path) -> bool:
+def writable(path: Path) -> bool:
     """Whether ``path`` (or, if it does not exist, its nearest existing parent) is writable."""
     p = path
     while not p.exists():
@@ -73,10 +75,10 @@ def cache_directory(source_dirs: tuple[Path, ...] = _SOURCE_DIRS) -> tuple[str, 
     env = os.environ.get("NUMBA_CACHE_DIR")
     if env:
         return "NUMBA_CACHE_DIR", Path(env)
-    if all(_writable(d / "__pycache__") for d in source_dirs):
+    if all(writable(d / "__pycache__") for d in source_dirs):
         return "in-tree", None
     user = _user_cache()
-    if _writable(user):
+    if writable(user):
         return "user", user
     return "temporary", Path(tempfile.gettempdir()) / f"sandwich-numba-cache-{os.getuid()}"
 
@@ -130,14 +132,16 @@ class Kernel:
     dispatcher (``_numba_type_``), so the AOT build links the same functions as the JIT.
     """
 
-    def __init__(self, fn: Callable, reassociate: bool) -> None:
+    def __init__(self, fn: Callable, reassociate: bool, *, register: bool = True) -> None:
+        """Wrap ``fn``; ``register``: list it in :func:`kernels` (what the AOT build compiles)."""
         self.py_func = fn
         self.reassociate = reassociate
         self.key = f"{fn.__module__}.{fn.__qualname__}"
         self._jit = None
         self._aot: tuple | None = None
         functools.update_wrapper(self, fn)
-        _KERNELS.append(self)
+        if register:
+            _KERNELS.append(self)
 
     @property
     def jit(self) -> Callable:
@@ -230,15 +234,15 @@ def manifest_mismatch(manifest: dict) -> str:
 
 def kernel_backend() -> dict[str, str]:
     """``{"backend": "aot" | "jit", "reason": ...}``: whether the AOT build is used, or why not."""
-    _aot_exports()
+    aot_exports()
     return dict(_backend)
 
 
 @functools.cache
-def _aot_exports() -> dict[str, tuple]:
+def aot_exports() -> dict[str, tuple]:
     """Kernel key → ((exported types, AOT function), ...) from a valid build, else {}.
 
-    A :class:`Kernel` makes the matchers of its own exports (:func:`_matcher`) on its first
+    A :class:`Kernel` makes the matchers of its own exports (:func:`argument_matcher`) on its first
     call: a run builds only those of the kernels it calls (fig. 5 at the paper's core: ≈ 7 ms
     of its solve for all 36 exports, made on the first evaluation).
     """
@@ -271,16 +275,16 @@ def _own_exports(key: str) -> tuple:
     """((argument matcher, AOT function), ...) of kernel ``key``; () sends it to the JIT.
 
     A manifest entry whose types cannot be read (a broken or foreign build) must not stop a
-    run, as a build that does not load does not (:func:`_aot_exports`): that kernel runs under
+    run, as a build that does not load does not (:func:`aot_exports`): that kernel runs under
     the JIT.
     """
     try:
-        return tuple((_matcher(spec), fn) for spec, fn in _aot_exports().get(key, ()))
+        return tuple((argument_matcher(spec), fn) for spec, fn in aot_exports().get(key, ()))
     except Exception:  # any malformed entry: the JIT is always there
         return ()
 
 
-def _matcher(spec: list[list]) -> Callable[[tuple], bool]:
+def argument_matcher(spec: list[list]) -> Callable[[tuple], bool]:
     """A function telling whether call arguments have exactly the exported types ``spec``.
 
     Each entry: ``["array", dtype, ndim, layout, writeable]`` or ``["float"]``, ``["int"]``,

@@ -28,7 +28,7 @@ needs_build = pytest.mark.skipif(not BUILT, reason=f"no AOT build: {jit.kernel_b
 def test_matcher_accepts_only_the_exported_types():
     spec = [["array", "float64", 2, "C", True], ["array", "int32", 1, "A", False], ["float"],
             ["int"], ["bool"]]
-    m = jit._matcher(spec)
+    m = jit.argument_matcher(spec)
     a, i = np.zeros((3, 2)), np.arange(4, dtype=np.int32)
     assert m((a, i, 1.0, 2, True))
     assert m((a, i[::2], np.float64(1.0), np.int64(2), np.bool_(False)))  # layout "A": any
@@ -57,7 +57,7 @@ def _manifest_at(tmp_path, monkeypatch, **changes):
     path.write_text(json.dumps(manifest))
     monkeypatch.setattr(jit, "AOT_MANIFEST", path)
     monkeypatch.setattr(jit, "AOT_MODULE", "sandwich.solver._no_such_module")
-    jit._aot_exports.cache_clear()
+    jit.aot_exports.cache_clear()
 
 
 @pytest.mark.parametrize("changes, reason", [
@@ -70,12 +70,12 @@ def test_a_stale_foreign_or_broken_build_is_not_used(tmp_path, monkeypatch, chan
     monkeypatch.delenv("SANDWICH_KERNELS", raising=False)
     try:
         _manifest_at(tmp_path, monkeypatch, **changes)
-        assert jit._aot_exports() == {}
+        assert jit.aot_exports() == {}
         assert jit.kernel_backend()["backend"] == "jit"
         assert reason in jit.kernel_backend()["reason"]
     finally:
         monkeypatch.undo()
-        jit._aot_exports.cache_clear()
+        jit.aot_exports.cache_clear()
 
 
 def test_no_build_is_used_where_the_cpu_cannot_be_identified(tmp_path, monkeypatch):
@@ -85,26 +85,26 @@ def test_no_build_is_used_where_the_cpu_cannot_be_identified(tmp_path, monkeypat
     try:
         monkeypatch.setattr(jit, "machine_key", lambda: {**real(), "cpu": ""})
         _manifest_at(tmp_path, monkeypatch)  # a manifest matching that key exactly
-        assert jit._aot_exports() == {}
+        assert jit.aot_exports() == {}
         assert "cannot be identified" in jit.kernel_backend()["reason"]
     finally:
         monkeypatch.undo()
-        jit._aot_exports.cache_clear()
+        jit.aot_exports.cache_clear()
 
 
 def test_missing_build_and_the_jit_switch(tmp_path, monkeypatch):
     try:
         monkeypatch.setattr(jit, "AOT_MANIFEST", tmp_path / "none.json")
-        jit._aot_exports.cache_clear()
-        assert jit._aot_exports() == {} and "no ahead-of-time build" in jit.kernel_backend()[
+        jit.aot_exports.cache_clear()
+        assert jit.aot_exports() == {} and "no ahead-of-time build" in jit.kernel_backend()[
             "reason"]
         monkeypatch.setenv("SANDWICH_KERNELS", "jit")
-        jit._aot_exports.cache_clear()
-        assert jit._aot_exports() == {} and jit.kernel_backend()["reason"] == (
+        jit.aot_exports.cache_clear()
+        assert jit.aot_exports() == {} and jit.kernel_backend()["reason"] == (
             "SANDWICH_KERNELS=jit")
     finally:
         monkeypatch.undo()
-        jit._aot_exports.cache_clear()
+        jit.aot_exports.cache_clear()
 
 
 _PROBE = r"""
@@ -188,15 +188,15 @@ def test_a_call_the_build_does_not_cover_runs_the_jit():
 def test_a_malformed_export_entry_runs_the_jit(monkeypatch):
     """An entry whose types cannot be read must not stop a run (its kernel takes the JIT).
 
-    The matchers are made on a kernel's first call, outside :func:`jit._aot_exports`'s guard.
+    The matchers are made on a kernel's first call, outside :func:`jit.aot_exports`'s guard.
     """
     def never(*args):
         raise AssertionError("an export with unreadable types was called")
 
-    kernel = jit.Kernel(lambda x: 2.0 * x, False)
-    monkeypatch.setattr(jit, "_aot_exports",
+    kernel = jit.Kernel(lambda x: 2.0 * x, False, register=False)
+    assert kernel not in jit.kernels()  # not one of the project's kernels
+    monkeypatch.setattr(jit, "aot_exports",
                         lambda: {kernel.key: ((["no such kind"], never),)})
-    jit._KERNELS.remove(kernel)  # not one of the project's kernels
     assert kernel(1.5) == 3.0
 
 
@@ -206,7 +206,8 @@ def test_the_build_runs_from_a_read_only_copy(tmp_path):
     site = tmp_path / "site"
     for pkg in ("sandwich",):
         shutil.copytree(ROOT / pkg, site / pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    for d in (site / "sandwich" / "solver", site / "sandwich" / "beam"):
+    for d in (site / "sandwich" / "solver", site / "sandwich" / "solver" / "envelope",
+              site / "sandwich" / "beam"):
         (d / "__pycache__").write_text("not a directory")
     code = ("import sys, numpy as np, scipy.sparse as sp\n"
             "from sandwich.solver import envelope, jit\n"

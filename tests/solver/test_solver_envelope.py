@@ -9,11 +9,11 @@ import pytest
 import scipy.sparse as sp
 
 from sandwich.solver import SingularTangentError, SparseFactorization, envelope, jit
-from sandwich.solver.envelope import (
-    EnvelopeFactorization,
-    EnvelopeStructure,
-    factorize_envelope,
-)
+from sandwich.solver.envelope import EnvelopeFactorization, EnvelopeStructure, factorize_envelope
+from sandwich.solver.envelope import factorization as envelope_factorization
+from sandwich.solver.envelope import structure as envelope_structure
+from sandwich.solver.envelope.panels import panel_flops
+from sandwich.solver.envelope.patterns import column_last, pattern_union, same_memory
 
 
 def _variable_band(rng, n, widths):
@@ -32,9 +32,8 @@ def _variable_band(rng, n, widths):
 @pytest.mark.parametrize("storage", ["envelope", "columns"])
 @pytest.mark.parametrize("seed", range(10))
 def test_inertia_and_solve_on_random_indefinite_envelopes(seed, storage, monkeypatch):
-    from sandwich.solver import envelope
-
-    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 0.0 if storage == "envelope" else 1e9)
+    advantage = 0.0 if storage == "envelope" else 1e9  # force the storage
+    monkeypatch.setattr(envelope_structure, "COLUMN_ADVANTAGE", advantage)
     rng = np.random.default_rng(seed)
     n = int(rng.integers(8, 80))
     widths = rng.integers(0, 6, size=n)
@@ -65,7 +64,7 @@ def test_panels_give_the_inertia_and_solves_of_dense_lapack(seed, monkeypatch):
     widths[rng.integers(0, n, size=5)] = rng.integers(0, 5, size=5)  # a few narrow rows
     A = _variable_band(rng, n, widths)
     A.sort_indices()
-    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)  # column storage
+    monkeypatch.setattr(envelope_structure, "COLUMN_ADVANTAGE", 1e9)  # column storage
     s = EnvelopeStructure.of(A)
     assert s.storage == "columns" and s.panels and s.n % envelope.PANEL
     _check_column_factorisation(A, s, rng)
@@ -95,7 +94,7 @@ def _column_factors(fac):
     s = fac.structure
     L, D = np.eye(s.n), np.empty(s.n)
     for j in range(s.n):
-        col = fac._env[s.colptr[j]:s.colptr[j + 1]]
+        col = fac.factors[s.colptr[j]:s.colptr[j + 1]]
         D[j] = col[0]
         L[j + 1:s.last[j] + 1, j] = col[1:]
     return L, D
@@ -126,7 +125,7 @@ def test_column_kernel_on_node_blocks_gives_the_inertia_and_small_backward_error
     columns are updated in pairs (`_paired_update`, an odd one alone at the end), mixed with
     panels that do not: negative pivots against eigvalsh, solves against the dense matrix, and
     the factors' backward error within Higham's bound."""
-    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)  # column storage, natural order
+    monkeypatch.setattr(envelope_structure, "COLUMN_ADVANTAGE", 1e9)  # columns, natural order
     rng = np.random.default_rng(200 + seed)
     sizes = rng.choice([4, 8] if seed < 3 else [3, 4, 5, 7], size=int(rng.integers(8, 30)))
     A = _node_blocks(rng, sizes)
@@ -141,8 +140,8 @@ def test_column_kernel_on_node_blocks_gives_the_inertia_and_small_backward_error
 @pytest.mark.parametrize("seed", range(4))
 def test_panels_on_narrow_bands_too(seed, monkeypatch):
     """Forced onto the small random envelopes (every width, panels wider than the band)."""
-    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 1e9)
-    monkeypatch.setattr(envelope, "PANEL_MIN_WIDTH", -1)
+    monkeypatch.setattr(envelope_structure, "COLUMN_ADVANTAGE", 1e9)
+    monkeypatch.setattr(envelope_structure, "PANEL_MIN_WIDTH", -1)
     rng = np.random.default_rng(seed)
     n = int(rng.integers(3, 40))
     A = _variable_band(rng, n, rng.integers(0, 12, size=n))
@@ -159,9 +158,7 @@ def test_panels_on_narrow_bands_too(seed, monkeypatch):
 def test_explicit_zeros_in_wide_rows_are_skipped_with_the_same_answer(monkeypatch):
     """A pattern wider than its values (a contact pair's unchosen segments): same inertia and
     solution as the dense matrix, at the numerical envelope's operation count."""
-    from sandwich.solver import envelope
-
-    monkeypatch.setattr(envelope, "COLUMN_ADVANTAGE", 0.0)  # the row envelope
+    monkeypatch.setattr(envelope_structure, "COLUMN_ADVANTAGE", 0.0)  # the row envelope
     rng = np.random.default_rng(7)
     n = 60
     A = _variable_band(rng, n, np.full(n, 3))
@@ -358,13 +355,13 @@ def test_refused_in_rcm_order_is_factorised_in_the_natural_order(seed, monkeypat
 def _orders_tried(monkeypatch):
     """The orderings :func:`factorize_envelope` tries its LDLᵀ in, recorded as it goes."""
     tried = []
-    trusted = envelope._trusted_ldlt
+    trusted = envelope_factorization.trusted_ldlt
 
     def record(A, structure, rtol):
         tried.append(structure.ordering)
         return trusted(A, structure, rtol)
 
-    monkeypatch.setattr(envelope, "_trusted_ldlt", record)
+    monkeypatch.setattr(envelope_factorization, "trusted_ldlt", record)
     return tried
 
 
@@ -438,12 +435,12 @@ def test_bad_matrices_are_refused():
 def test_cache_directory_rules(tmp_path, monkeypatch):
     """Read-only install: numba's in-tree cache, else the user cache, else a temporary dir."""
     read_only = {tmp_path / "ro", tmp_path / "home"}
-    real = jit._writable
+    real = jit.writable
 
     def writable(path):
         return not any(p == path or p in path.parents for p in read_only) and real(path)
 
-    monkeypatch.setattr(jit, "_writable", writable)
+    monkeypatch.setattr(jit, "writable", writable)
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     assert jit.cache_directory((tmp_path / "src",)) == ("in-tree", None)
@@ -477,7 +474,8 @@ def test_kernels_run_from_a_read_only_install(tmp_path):
                XDG_CACHE_HOME=str(tmp_path / "nohome" / ".cache"), PYTHONDONTWRITEBYTECODE="1")
     # read-only: without root, chmod; with root (mode bits ignored), a file where the cache dirs
     # would go blocks them just as well
-    for d in (site / "sandwich" / "solver", site / "sandwich" / "beam"):
+    for d in (site / "sandwich" / "solver", site / "sandwich" / "solver" / "envelope",
+              site / "sandwich" / "beam"):
         (d / "__pycache__").write_text("not a directory")
     (tmp_path / "nohome").write_text("not a directory")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
@@ -546,22 +544,22 @@ def test_storage_arrays_are_reused_only_when_no_factorisation_holds_them():
         assert isinstance(fac, EnvelopeFactorization)
         assert np.allclose(A @ fac.solve(b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
     assert np.array_equal(fac1.solve(b), x1)  # held all along: never overwritten
-    before = {e.ctypes.data for e in s.__dict__["_spares"]}  # addresses: no extra reference
+    before = set(s.spare_addresses)  # addresses: no extra reference
     del fac  # its array comes free
     A = on_the_pattern()
     fac = factorize_envelope(A, s)
-    assert fac._env.ctypes.data in before  # reused, not new
+    assert fac.factors.ctypes.data in before  # reused, not new
     assert np.allclose(A @ fac.solve(b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
 
 
 def test_panel_flop_count_against_a_panel_by_panel_count():
-    """``_panel_flops`` (vectorised) against a count written panel by panel from the kernel's
+    """``panel_flops`` (vectorised) against a count written panel by panel from the kernel's
     loops: per column 1 reciprocal + m products + 2 per earlier panel column and row; per
     trailing column of a panel reaching R, a rank-8 update of R − k + 1 rows (16 flops each,
     the padding's zero terms included)."""
     rng = np.random.default_rng(3)
     for n in (1, 7, 8, 9, 100, 203):
-        last = envelope._column_last(np.maximum(np.arange(n) - rng.integers(0, 30, n), 0))
+        last = column_last(np.maximum(np.arange(n) - rng.integers(0, 30, n), 0))
         count = 0
         for j in range(0, n, envelope.PANEL):
             w = min(envelope.PANEL, n - j)
@@ -570,13 +568,13 @@ def test_panel_flop_count_against_a_panel_by_panel_count():
                 count += 1 + m + 2 * p * (m + 1)
             R = int(last[j + w - 1])
             count += sum(16 * (R - k + 1) for k in range(j + w, R + 1))
-        assert envelope._panel_flops(last) == count
+        assert panel_flops(last) == count
 
 
 @pytest.mark.parametrize("seed", range(6))
 def test_pattern_union_is_the_rows_set_union(seed):
     # reference: the per-row set union of two random sorted CSR patterns (empty rows, full rows,
-    # shared entries; int32 and int64 index arrays as scipy and _values_pattern give them)
+    # shared entries; int32 and int64 index arrays as scipy and values_pattern give them)
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 40))
 
@@ -589,7 +587,7 @@ def test_pattern_union_is_the_rows_set_union(seed):
 
     *a, ra = pattern(np.int32)
     *b, rb = pattern(np.int64)
-    ptr, ind = envelope._pattern_union(n, tuple(a), tuple(b))
+    ptr, ind = pattern_union(n, tuple(a), tuple(b))
     assert ptr.dtype == ind.dtype == np.int64 and ptr[0] == 0 and ptr[-1] == ind.size
     for r in range(n):
         assert ind[ptr[r]:ptr[r + 1]].tolist() == sorted(set(ra[r]) | set(rb[r]))
@@ -605,10 +603,10 @@ def test_a_structure_matches_its_pattern_through_new_views_and_copies_only():
     s = EnvelopeStructure.of(K)
     on_it = sp.csr_matrix((rng.normal(size=s.indices.size), s.indices, s.indptr), shape=K.shape)
     assert on_it.indices is not s.indices  # the case the memory test is for
-    assert envelope._same_memory(on_it.indices, s.indices)
+    assert same_memory(on_it.indices, s.indices)
     assert s.matches(on_it)
     copied = sp.csr_matrix((on_it.data, s.indices.copy(), s.indptr.copy()), shape=K.shape)
-    assert not envelope._same_memory(copied.indices, s.indices)
+    assert not same_memory(copied.indices, s.indices)
     assert s.matches(copied)
     other = copied.copy()  # the same sizes, one column moved: row 0's last entry one further
     row0 = other.indices[other.indptr[0]:other.indptr[1]]
@@ -616,5 +614,5 @@ def test_a_structure_matches_its_pattern_through_new_views_and_copies_only():
     row0[-1] += 1
     assert not np.array_equal(other.indices, s.indices)
     assert not s.matches(other)
-    assert not envelope._same_memory(s.indices[:-1], s.indices)
-    assert not envelope._same_memory(s.indices[::2], s.indices[:s.indices.size // 2 + 1])
+    assert not same_memory(s.indices[:-1], s.indices)
+    assert not same_memory(s.indices[::2], s.indices[:s.indices.size // 2 + 1])

@@ -1,0 +1,98 @@
+"""What the commands share: exit codes, loading scenes, the resolution options, the memory guard.
+
+Every command refuses a bad scene, bad option or unusable output folder before any work (exit
+code 2, one line per problem naming the file or option, the key and the reason), and so does
+every command that solves or meshes for a run estimated not to fit in the memory available
+(:func:`guard_memory`, :mod:`sandwich.cli.memory_guard`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from sandwich.cli.memory_guard import check_memory
+from sandwich.models import mpi_rank, with_options
+from sandwich.scene import Scene, SceneError
+from sandwich.scene_file import load_scene
+
+__all__ = ["CLI_KEYS", "ELEMENTS_RANGE", "EXIT_BAD_INPUT", "EXIT_INTERNAL", "EXIT_OK",
+           "EXIT_STOPPED", "REFINE_RANGE", "RESULTS", "UsageError", "default_out", "guard_memory",
+           "load_scenes", "overridden", "say"]
+
+EXIT_OK, EXIT_STOPPED, EXIT_BAD_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
+RESULTS = Path("results")
+REFINE_RANGE = (0, 6)  # as the scene's [reference2d] refine
+ELEMENTS_RANGE = (2, 200_000)  # as the scene's [beam_model] elements
+CLI_KEYS = {"elements": "beam_model.elements", "refine": "reference2d.refine",
+            "level": "reference2d.level"}  # option -> the scene key it overrides
+
+
+class UsageError(ValueError):
+    """A command-line option that cannot be used: which option and why."""
+
+
+def say(args: argparse.Namespace, msg: str) -> None:
+    """Print ``msg`` unless the command is ``--quiet`` (or not MPI rank 0)."""
+    if not getattr(args, "quiet", False) and mpi_rank() == 0:
+        print(msg, flush=True)
+
+
+def load_scenes(paths: list[str]) -> list[Scene]:
+    """Load every scene or raise one SceneError carrying all their problems."""
+    scenes, problems = [], []
+    for p in paths:
+        try:
+            scenes.append(load_scene(p))
+        except SceneError as exc:
+            problems.extend(exc.problems)
+    if problems:
+        raise SceneError(problems)
+    return scenes
+
+
+def default_out(scene: Scene, model: str) -> Path:
+    """The default result folder ``results/<scene>/<model>/``."""
+    return RESULTS / scene.name / model
+
+
+def _in_range(value: int | None, option: str, lo: int, hi: int) -> int | None:
+    if value is not None and not lo <= value <= hi:
+        raise UsageError(f"option {option}: must be between {lo} and {hi}, got {value}")
+    return value
+
+
+def overridden(scene: Scene, model: str, args: argparse.Namespace) -> Scene:
+    """``scene`` with the resolution options given on the command line applied to ``model``."""
+    level = getattr(args, "level", None)
+    refine = _in_range(getattr(args, "refine", None), "--refine", *REFINE_RANGE)
+    elements = _in_range(getattr(args, "elements", None), "--elements", *ELEMENTS_RANGE)
+    if model == "2d":
+        if elements is not None:
+            raise UsageError("option --elements: sets the beam's elements, not the 2D model's")
+        if level == "explicit" and scene.reference2d.core_size is None:
+            raise UsageError("option --level: 'explicit' needs [reference2d] core_size in the "
+                             "scene")
+        return with_options(scene, "2d", level=level, refine=refine)
+    if level is not None or refine is not None:
+        raise UsageError("options --level/--refine: set the 2D mesh, not the beam's elements")
+    return with_options(scene, "beam", elements=elements)
+
+
+def guard_memory(scenes: list[Scene], models: tuple[str, ...], args: argparse.Namespace, *,
+                 copies: int = 1, where: str | None = None, label: str = "") -> None:
+    """Refuse before any work a run estimated not to fit in memory; warn when it is close."""
+    given = {key: f"--{opt}" for opt, key in CLI_KEYS.items()
+             if getattr(args, opt, None) is not None}
+    problems = []
+    for scene in scenes:
+        for model in models:
+            verdict = check_memory(scene, model, given, copies=copies, where=where,
+                                   label=label)
+            if verdict.refusal is not None:
+                problems.append(verdict.refusal)
+            elif verdict.warning is not None and mpi_rank() == 0:
+                print(f"warning: {where or scene.source}: {verdict.warning}", file=sys.stderr)
+    if problems:
+        raise SceneError(problems)

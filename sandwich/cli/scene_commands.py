@@ -1,0 +1,122 @@
+"""The commands on one scene: ``validate``, ``mesh`` and ``solve``.
+
+A solve that stops before its target, or is interrupted (Ctrl-C, SIGTERM), keeps and writes
+every converged step and exits with code 1 after saying where and why.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+from sandwich.cli.common import (
+    EXIT_OK,
+    EXIT_STOPPED,
+    RESULTS,
+    default_out,
+    guard_memory,
+    load_scenes,
+    overridden,
+    say,
+)
+from sandwich.models import mpi_rank, run_model
+from sandwich.results import check_output_folder
+from sandwich.scene import Scene
+
+__all__ = ["LARGE_BEAM", "cmd_mesh", "cmd_solve", "cmd_validate", "warnings_before_solve"]
+
+LARGE_BEAM = 20_000  # beam elements above which a solve takes minutes and gigabytes
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """Check scene files and say which are usable."""
+    for s in load_scenes(args.scenes):
+        say(args, f"ok: {s.source} ({s.name}: {len(s.debonds)} debond(s), "
+             f"{len(s.supports)} support(s), {len(s.loads)} load(s))")
+    return EXIT_OK
+
+
+def cmd_mesh(args: argparse.Namespace) -> int:
+    """Mesh a scene for the 2D reference and print a quality report."""
+    (scene,) = load_scenes([args.scene])
+    scene = overridden(scene, "2d", args)
+    guard_memory([scene], ("mesh",), args)
+    out = Path(args.out) if args.out else RESULTS / scene.name / "mesh"
+    check_output_folder(out)
+    from sandwich.meshes import build_mesh, quality_report, write_mesh
+
+    mesh = build_mesh(scene)
+    files = write_mesh(mesh, out, scene.name)
+    say(args, str(quality_report(mesh)))
+    for kind, path in files.items():
+        say(args, f"wrote {kind}: {path}")
+    return EXIT_OK
+
+
+class _StepBar:
+    """Feeds the runner's step events to a progress bar."""
+
+    def __init__(self, bar):
+        self.bar = bar
+
+    def __call__(self, event) -> None:
+        if event.phase == "step":
+            self.bar(event)
+        elif event.phase == "note":  # the bar restarts with the path
+            self.bar(SimpleNamespace(step=0, load_factor=0.0, probes={}, message=event.message))
+
+
+def warnings_before_solve(scene: Scene, model: str) -> list[str]:
+    """What a user should know before a solve starts (the solve still runs)."""
+    out = []
+    for i, ld in enumerate(scene.loads):
+        lo, hi = ld.span
+        for j, sup in enumerate(scene.supports):
+            if ld.on in sup.faces and lo - 1e-9 <= sup.x <= hi + 1e-9:
+                out.append(f"loads[{i}] acts over supports[{j}] (x = {sup.x:g} mm on the "
+                           f"{ld.on} face): the support takes the load through the core, which "
+                           "may crush there")
+    a = scene.analysis
+    if a.until_load_factor is not None and a.until_load_factor < 0:
+        out.append(f"analysis.until.load_factor = {a.until_load_factor:g} < 0 reverses every "
+                   "load's force")
+    if model == "beam" and scene.beam_model.elements > LARGE_BEAM:
+        out.append(f"beam_model.elements = {scene.beam_model.elements} is above {LARGE_BEAM}: "
+                   "expect minutes and gigabytes")
+    return out
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    """Solve one scene with one model."""
+    from sandwich.progress import PathProgress
+
+    (scene,) = load_scenes([args.scene])
+    scene = overridden(scene, args.model, args)
+    guard_memory([scene], (args.model,), args)
+    out = Path(args.out) if args.out else default_out(scene, args.model)
+    check_output_folder(out)
+    for line in warnings_before_solve(scene, args.model):
+        print(f"warning: {scene.source}: {line}", file=sys.stderr)
+    t0 = time.perf_counter()
+    quiet = args.quiet or mpi_rank() != 0
+    try:
+        with PathProgress(scene, f"{scene.name} [{args.model}]", quiet=quiet) as bar:
+            sol = run_model(scene, args.model, out, progress=_StepBar(bar))
+    except KeyboardInterrupt:
+        print(f"interrupted: every converged step is written to {out}/", file=sys.stderr)
+        return EXIT_STOPPED
+    say(args, f"{args.model}: {len(sol.history)} converged step(s), final load factor "
+         f"{sol.final_load_factor:.6g}, {sol.dofs} DOFs, {time.perf_counter() - t0:.1f} s")
+    for lp in sol.limit_points:
+        where = (f"in step {lp.step} (between load factors {lp.between[0]:.6g} and "
+                 f"{lp.between[1]:.6g})" if lp.located_at is not None and lp.between
+                 else f"at step {lp.step}")
+        say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
+    say(args, f"results in {out}/ (history.csv, profiles.csv, summary.json)")
+    if not sol.converged:
+        print(f"stopped before the target: {sol.message}", file=sys.stderr)
+        return EXIT_STOPPED
+    return EXIT_OK
