@@ -362,7 +362,7 @@ def write_iterations(rows, reference, peak, before, after, stamp):
         "the contact pairs' closest-point projections included (computed afresh at every "
         "evaluation, as at a new iterate; until 2026-12-05 the repeated evaluations of one "
         "state reused them, ≈ 0.12 ms at 240 elements that the table left out), "
-        "envelope LDLᵀ with inertia (`sandwich/solver/envelope.py`), and the corrector's two "
+        "envelope LDLᵀ with inertia (`sandwich/solver/envelope/`), and the corrector's two "
         f"solves. Best of 15 below {SMALL_DOFS} free DOFs, else of 3. Flops: the kernels' "
         "GEMMs (strains/stresses and scatter not counted), the factorisation and the solves, "
         "exactly as executed. Peak: this machine's "
