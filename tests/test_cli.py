@@ -206,3 +206,19 @@ def test_a_critical_point_located_within_its_step_is_said_so(tmp_path, capsys):
     assert low < lp["load_factor"] < high
     assert said[0].strip() == (f"bifurcation in step {lp['step']} (between load factors "
                                f"{low:.6g} and {high:.6g}): load factor {lp['load_factor']:.6g}")
+
+
+def test_solve_names_every_file_it_wrote(tmp_path, capsys):
+    from sandwich.cli import main as cli_main
+
+    scene = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
+    text = scene.read_text().replace('kind = "nonlinear"', 'kind = "linear"')
+    path = tmp_path / "s.toml"
+    path.write_text(text + '\n[beam_model]\ncore = 1\nelements = 40\n')
+    assert cli_main(["solve", str(path), "--model", "beam", "--out", str(tmp_path / "r")]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("results in"))
+    written = {p.name for p in (tmp_path / "r").iterdir()}
+    for name in ("history.csv", "profiles.csv", "summary.json", "tip_tractions.csv",
+                 "fields.pvd"):
+        assert name in written and name in line, (name, line)
+    assert "fields_*.vtu" in line

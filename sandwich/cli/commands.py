@@ -63,6 +63,17 @@ def _version() -> str:
         return "sandwich (not installed)"
 
 
+def _resolution_options(p: argparse.ArgumentParser) -> None:
+    """``--level``/``--refine`` (the 2D mesh) and ``--elements`` (the beam) of one command."""
+    p.add_argument("--level", choices=MESH_LEVELS, help="2D mesh level (overrides the scene)")
+    p.add_argument("--refine", type=int, metavar="N",
+                   help="2D uniform refinements, 0-6, each halves every element size "
+                        "(overrides the scene)")
+    p.add_argument("--elements", type=int, metavar="N",
+                   help="beam element count along the span, 2-200000 (overrides the scene's "
+                        "[beam_model] elements)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``sandwich`` command."""
     p = argparse.ArgumentParser(
@@ -99,13 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="beam: the sandwich beam element (the paper's, refined through the "
                    "thickness); 2d: the plane-stress reference (FEniCSx)")
     s.add_argument("--out", help="result folder (default results/<scene>/<model>/)")
-    s.add_argument("--level", choices=MESH_LEVELS, help="2D mesh level (overrides the scene)")
-    s.add_argument("--refine", type=int, metavar="N",
-                   help="2D uniform refinements, 0-6, each halves every element size "
-                        "(overrides the scene)")
-    s.add_argument("--elements", type=int, metavar="N",
-                   help="beam element count along the span, 2-200000 (overrides the scene's "
-                        "[beam_model] elements)")
+    _resolution_options(s)
     s.set_defaults(func=cmd_solve)
 
     c = sub.add_parser("compare", parents=[common],
@@ -116,6 +121,7 @@ def build_parser() -> argparse.ArgumentParser:
                                  "results/<scene>/<model>/)")
     c.add_argument("--no-reuse", action="store_true",
                    help="solve both models again even if their results match")
+    _resolution_options(c)
     c.set_defaults(func=cmd_compare)
 
     g = sub.add_parser("gallery", parents=[common],
@@ -128,6 +134,8 @@ def build_parser() -> argparse.ArgumentParser:
     d = sub.add_parser("demo", parents=[common], help="run the default scene end to end")
     d.add_argument("scene", nargs="?", default=DEMO_SCENE,
                    help=f"scene file (default {DEMO_SCENE}, also from outside the checkout)")
+    d.add_argument("--out", help="folder of the comparison and, inside it, of both models' "
+                                 "results (default results/<scene>/compare/)")
     d.set_defaults(func=cmd_demo)
 
     st = sub.add_parser("study", parents=[common],

@@ -80,6 +80,14 @@ def overridden(scene: Scene, model: str, args: argparse.Namespace) -> Scene:
     return with_options(scene, "beam", elements=elements)
 
 
+def overridden_both(scene: Scene, args: argparse.Namespace) -> Scene:
+    """``scene`` with ``--level``/``--refine`` on the 2D model and ``--elements`` on the beam."""
+    only_2d = argparse.Namespace(level=getattr(args, "level", None),
+                                 refine=getattr(args, "refine", None))
+    only_beam = argparse.Namespace(elements=getattr(args, "elements", None))
+    return overridden(overridden(scene, "2d", only_2d), "beam", only_beam)
+
+
 def guard_memory(scenes: list[Scene], models: tuple[str, ...], args: argparse.Namespace, *,
                  copies: int = 1, where: str | None = None, label: str = "") -> None:
     """Refuse before any work a run estimated not to fit in memory; warn when it is close."""

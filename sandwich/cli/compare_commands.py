@@ -14,6 +14,7 @@ from sandwich.cli.common import (
     RESULTS,
     guard_memory,
     load_scenes,
+    overridden_both,
     say,
 )
 from sandwich.models import MODELS, PROJECT_ROOT, ModelRun
@@ -37,7 +38,11 @@ def _compare_and_report(args: argparse.Namespace, scene: Scene, out: Path,
                         results_root: Path | None) -> int:
     """Run (or reuse) both models on ``scene``, write the comparison and summarise it."""
     from sandwich.compare import compare
+    from sandwich.compare.compare import total_force
+    from sandwich.compare.metrics import critical_lines
     from sandwich.models import text_progress
+
+    scene = overridden_both(scene, args)
 
     guard_memory([scene], tuple(MODELS), args)
     check_output_folder(out)
@@ -52,6 +57,11 @@ def _compare_and_report(args: argparse.Namespace, scene: Scene, out: Path,
     _report_runs(args, cmp.runs)
     for model, reason in cmp.missing.items():
         print(f"{model}: no result ({reason})", file=sys.stderr)
+    for model, sol in cmp.solutions.items():
+        for w in sol.warnings:
+            print(f"WARNING ({model}): {w}", file=sys.stderr)
+    for line in critical_lines(cmp.metrics, total_force(scene)):
+        say(args, line)
     curve = cmp.metrics.curve("load_factor")
     if curve is not None and curve.l2_relative is not None:
         say(args, f"load-deflection curve, beam vs 2D: L2 error {100 * curve.l2_relative:.2f} %, "
@@ -108,4 +118,6 @@ def cmd_demo(args: argparse.Namespace) -> int:
     if args.scene == DEMO_SCENE and not path.is_file():  # run from outside the repository
         path = PROJECT_ROOT / DEMO_SCENE
     (scene,) = load_scenes([str(path)])
+    if args.out:
+        return _compare_and_report(args, scene, Path(args.out), None)
     return _compare_and_report(args, scene, RESULTS / scene.name / "compare", RESULTS)

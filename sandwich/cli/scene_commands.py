@@ -69,6 +69,27 @@ class _StepBar:
             self.bar(SimpleNamespace(step=0, load_factor=0.0, probes={}, message=event.message))
 
 
+def written_files(folder: Path) -> str:
+    """The result files in ``folder``, the field frames counted: what a solve wrote there."""
+    from sandwich.results.writing import is_result_file
+
+    names = sorted(p.name for p in folder.iterdir() if is_result_file(p.name))
+    frames = [n for n in names if n.startswith("fields_") and n.endswith(".vtu")]
+    shown = [n for n in names if n not in frames]
+    if frames:
+        shown.append(f"{len(frames)} fields_*.vtu frame(s)")
+    return ", ".join(shown)
+
+
+def _steps_written(folder: Path) -> int:
+    """Converged steps in ``folder``'s history.csv (0 when it has none or cannot be read)."""
+    try:
+        lines = (folder / "history.csv").read_text().splitlines()
+    except OSError:
+        return 0
+    return sum(1 for ln in lines[1:] if ln.strip() and not ln.startswith("0,"))
+
+
 def warnings_before_solve(scene: Scene, model: str) -> list[str]:
     """What a user should know before a solve starts (the solve still runs)."""
     out = []
@@ -106,7 +127,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
         with PathProgress(scene, f"{scene.name} [{args.model}]", quiet=quiet) as bar:
             sol = run_model(scene, args.model, out, progress=_StepBar(bar))
     except KeyboardInterrupt:
-        print(f"interrupted: every converged step is written to {out}/", file=sys.stderr)
+        steps = _steps_written(out)
+        print("interrupted before any step converged: an empty history is written to "
+              f"{out}/" if not steps else
+              f"interrupted: the {steps} converged step(s) are written to {out}/",
+              file=sys.stderr)
         return EXIT_STOPPED
     say(args, f"{args.model}: {len(sol.history)} converged step(s), final load factor "
          f"{sol.final_load_factor:.6g}, {sol.dofs} DOFs, {time.perf_counter() - t0:.1f} s")
@@ -115,7 +140,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
                  f"{lp.between[1]:.6g})" if lp.located_at is not None and lp.between
                  else f"at step {lp.step}")
         say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
-    say(args, f"results in {out}/ (history.csv, profiles.csv, summary.json)")
+    say(args, f"results in {out}/ ({written_files(out)})")
+    for w in sol.warnings:
+        print(f"WARNING: {w}", file=sys.stderr)
     if not sol.converged:
         print(f"stopped before the target: {sol.message}", file=sys.stderr)
         return EXIT_STOPPED
