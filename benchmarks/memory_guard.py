@@ -98,7 +98,7 @@ def measure(argv: list[str], cwd: Path) -> dict:
             "stderr": (cwd / "stderr.txt").read_text()[-2000:]}
 
 
-def _row_id(row: dict) -> tuple:
+def row_id(row: dict) -> tuple:
     if row["kind"] == "beam":
         return ("beam", row["elements"], row["core"])
     if row["kind"].startswith("2d"):
@@ -114,7 +114,7 @@ def _solve_info(folder: Path) -> dict:
 def run_rows(have: list[dict]) -> list[dict]:
     """Measure every row not in ``have`` (each in a fresh temporary folder); all rows."""
     py = [sys.executable, "-m", "sandwich.cli"]
-    done = {_row_id(r): r for r in have}
+    done = {row_id(r): r for r in have}
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(tmp)

@@ -175,7 +175,7 @@ def test_the_constants_are_those_fitted_to_the_stored_measurements():
             if r.get("core") == "auto":  # an upper bound: every element at the cap (1.94 here)
                 assert 1.0 < ratio < 2.0, ratio
             else:
-                assert 1 / 1.25 < ratio < 1.25, (bench._row_id(r), ratio)
+                assert 1 / 1.25 < ratio < 1.25, (bench.row_id(r), ratio)
 
 
 def test_a_small_real_beam_run_is_within_a_factor_2_of_its_estimate(tmp_path, monkeypatch):

@@ -24,6 +24,7 @@ from petsc4py import PETSc
 
 from sandwich.plane2d import contact as ct
 from sandwich.plane2d.mesh import allreduce_array, block_input_coordinates, input_node_blocks
+from sandwich.plane2d.roundoff import ResidualRoundoff
 
 JIT = {"cffi_extra_compile_args": ["-O2"]}
 
@@ -128,7 +129,7 @@ class MumpsFactorization:
         """Nothing to free: the factors belong to the model."""
 
 
-class Reference2DSystem:
+class Reference2DSystem(ResidualRoundoff):
     """Equilibrium R(u, λ) = f_int(u) + f_contact(u) − λ f_ref of the 2D plane-stress model."""
 
     def __init__(self, V, internal, f_ref: np.ndarray, bc_dofs: np.ndarray,
@@ -415,46 +416,6 @@ class Reference2DSystem:
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
         A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return A
-
-    def residual_roundoff_bound(self) -> float:
-        """Round-off bound of the residual relative to the load: ε ‖ |K(0)| |u₁| ‖ / ‖f_ref‖.
-
-        u₁ = K(0)⁻¹ f_ref; the a-priori bound of the round-off in evaluating the residual, scale-
-        free along the linear range.
-
-        The through-thickness stiffness of thin face elements (E b l / h ~ 1e8 N/mm) times the ulp
-        of the displacement makes this 1e-8…1e-7 on the paper scenes, at or above the default
-        Newton tolerance of 1e-8; measured floors are ~1/10 of the bound.
-        """
-        K = self.tangent(np.zeros(self.size))
-        fac = self.factorize(K)
-        u1 = fac.solve(self.f_ref)
-        fac.destroy()
-        return self._abs_k_abs_u(K, u1) / max(self.norm(self.f_ref), 1e-300)
-
-    def residual_roundoff(self, u: np.ndarray) -> float:
-        """Round-off level of the residual at the state ``u`` (N): ε ‖ |K(u)| |u| ‖.
-
-        The state itself is stored to an ulp of each displacement, and the stiff
-        through-thickness terms of the thin faces turn that into residual: no Newton iterate can
-        go below this. Unlike :meth:`residual_roundoff_bound` (at u = 0, relative to the load)
-        it grows with |u| / λ, i.e. when the structure softens along the path.
-        """
-        return self._abs_k_abs_u(self.tangent(u), u)
-
-    def _abs_k_abs_u(self, K: PETSc.Mat, u: np.ndarray) -> float:
-        """ε ‖ |K| |u| ‖ (global norm)."""
-        B = K.copy()
-        ai, aj, av = B.getValuesCSR()
-        B.setValuesCSR(ai, aj, np.abs(av))
-        B.assemble()
-        x, y = B.createVecs()
-        x.array[:] = np.abs(u)
-        B.mult(x, y)
-        bound = np.finfo(float).eps * y.norm()
-        for obj in (B, x, y):
-            obj.destroy()
-        return float(bound)
 
     def dot(self, a: np.ndarray, b: np.ndarray) -> float:
         """Global inner product of two owned-DOF vectors (sum over ranks)."""
