@@ -28,6 +28,7 @@ README = ROOT / "README.md"
 SANDWICH = ".venv/bin/sandwich"
 SETUP = ["make demo", "make test"]
 HEAVY_COMMANDS = {"study", "gallery"}
+TIMEOUT, HEAVY_TIMEOUT = 600, 3600  # s per command; a study or gallery on a loaded 2-core machine
 MAX_LINES = 150
 FENCE = re.compile(r"^```[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
 EXIT_NOTE = re.compile(r"\bexit (\d)\b")
@@ -126,18 +127,20 @@ def _check_result_folder(args: list[str], cwd: Path) -> None:
 def _params():
     out = []
     for i, (args, code) in enumerate(tour()):
-        marks = [pytest.mark.heavy] if args[0] in HEAVY_COMMANDS else []
+        heavy = args[0] in HEAVY_COMMANDS
+        marks = [pytest.mark.heavy, pytest.mark.timeout(HEAVY_TIMEOUT)] if heavy else \
+            [pytest.mark.timeout(TIMEOUT)]
         out.append(pytest.param(args, code, id=f"{i}-{'-'.join(args[:2])}", marks=marks))
     return out
 
 
 @pytest.mark.dolfinx
-@pytest.mark.timeout(1800)
 @pytest.mark.parametrize(("args", "code"), _params())
 def test_tour_command_runs(workspace, args, code):
     cmd = [sys.executable, "-m", "sandwich.cli", *_expand(args, workspace)]
+    limit = HEAVY_TIMEOUT if args[0] in HEAVY_COMMANDS else TIMEOUT
     done = subprocess.run(cmd, cwd=workspace, env=_environment(), capture_output=True, text=True,
-                          timeout=1800)
+                          timeout=limit)
     assert done.returncode == code, (
         f"{' '.join(args)} exited {done.returncode}, README says {code}\n"
         f"{done.stdout[-2000:]}\n{done.stderr[-2000:]}")
