@@ -1,6 +1,6 @@
 """Beam vs 2D: local indentation of a bonded face under patch loads of decreasing width (linear).
 
-Experiment for docs/beam_vs_2d.md §3. The Fig 4 beam (bonded, three-point bending) is loaded
+Experiment for docs/comparisons.md §3. The Fig 4 beam (bonded, three-point bending) is loaded
 linearly (λ = 100 N) by a patch on the top face at mid-span whose width goes from the whole span
 down to 2.5 mm. Printed per width, for both models: w_top_mid, w_bottom_mid and the indentation
 w_top_mid − w_bottom_mid (the squeeze of the core under the load), and their beam/2D ratios.

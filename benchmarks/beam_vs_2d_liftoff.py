@@ -1,6 +1,6 @@
 """Beam vs 2D: where does the compressed debonded face go unstable, and what precedes it?
 
-Two experiments for docs/beam_vs_2d.md §3 (both models, profiles at every step):
+Two experiments for docs/comparisons.md §3 (both models, profiles at every step):
 
 - ``fig5``: the paper's Fig 5 scene (40 mm top debond, 10 mm patch load on top at mid-span) to
   ``w_top_mid = -5`` under displacement control in steps of at most ``STEP`` mm, so that the

@@ -4,7 +4,7 @@ Run from the project root: ``python -m benchmarks.beam_vs_2d_split SCENE UNTIL [
 [2D level] [load=patch|uniform] [kind=nonlinear|linear]``. Prints, at common load levels,
 w_top_mid, w_bottom_mid and their difference (indentation of the top face into the core) for
 both models. ``load=uniform`` replaces the patch by the same force spread over the whole top face
-(no local indentation) to isolate global behaviour. Throwaway experiment for docs/beam_vs_2d.md;
+(no local indentation) to isolate global behaviour. Throwaway experiment for docs/comparisons.md;
 it writes no table.
 """
 

@@ -3,7 +3,7 @@
 Run from the project root: ``python -m benchmarks.beam_vs_2d_support SCENE [elements] [level]``.
 Linear analyses at λ = 100 N (load control); prints w of both faces at the support (x = 0; the
 top face over the support shows how much the core is squeezed there), at x = 75 and at mid-span,
-for both models. Throwaway experiment for docs/beam_vs_2d.md; it writes no table.
+for both models. Throwaway experiment for docs/comparisons.md; it writes no table.
 """
 
 import argparse

@@ -7,7 +7,7 @@ auto] [--factors 1 10] [--out DIR]``. Writes ``benchmarks/results/beam/contact_w
 The penalty law of a debonded interface (``sandwich.beam.contact.pressure_law``) is regularised
 over a width s (default ``sandwich.beam.build.default_contact_smoothing``,
 1e-6 mm on the shipped scenes). Newton converges linearly on pairs in the law's exponential
-tail (docs/beam_speed.md, "What bounds the rest"), which sets the iteration count of every
+tail (docs/speed.md, "What bounds the rest"), which sets the iteration count of every
 debond scene. This benchmark solves each scene in this process with s × each factor
 (``build_model(contact_smoothing=...)``) and records the solve wall time, steps, Newton
 iterations, factorisations, penalty reruns (a wider law penetrates deeper at the same pressure;

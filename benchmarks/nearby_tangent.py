@@ -84,7 +84,7 @@ def main() -> None:
         "# Nearby evaluation A/B (`benchmarks/nearby_tangent.py`)", "",
         "Iterations after a converged increment: every iterate evaluated in full (before) "
         "against the layers' tangent kept and the contact law re-evaluated (after, as shipped; "
-        "`BeamModel.internal_force_nearby`, docs/beam_speed.md). In process, kernels warm, "
+        "`BeamModel.internal_force_nearby`, docs/speed.md). In process, kernels warm, "
         f"{stamp.rstrip('.')}; 1-minute load average "
         f"{start_load:.2f} at the start, {end_load:.2f} at the end (2 cores).", "",
         "| scene | core | before (s) | after (s) | speed-up | steps before / after | "

@@ -182,7 +182,7 @@ def test_a_small_real_beam_run_is_within_a_factor_2_of_its_estimate(tmp_path, mo
     """Measured here: peak RSS of a real solve (its own process) against the estimate.
 
     Under numba's JIT, as the stored calibration rows were measured: the kernels' ahead-of-time
-    build takes ≈ 131 MB less (numba and LLVM not loaded; paired runs in docs/beam_speed.md), so
+    build takes ≈ 131 MB less (numba and LLVM not loaded; paired runs in docs/speed.md), so
     the guard over-estimates such runs by that much more — on the safe side.
     """
     import json

@@ -30,7 +30,7 @@ def test_grading_and_element_count_come_from_the_scene():
 
 
 def test_face_membrane_option_changes_the_nonlinear_answer_only():
-    # the averaged option leaves the linear stiffness unchanged (docs/beam_vs_2d.md), so the
+    # the averaged option leaves the linear stiffness unchanged (docs/comparisons.md), so the
     # paths agree at the first step and differ at w = -5 mm, where membrane terms matter
     paper = run(_scene(-5.0, elements=60, face_membrane="paper")).solution.history
     avg = run(_scene(-5.0, elements=60, face_membrane="averaged")).solution.history

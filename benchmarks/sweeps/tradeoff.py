@@ -16,7 +16,7 @@ folder); the table says the machine and date it was measured on.
 
 Beam variants: ``paper`` (the paper's element: core level 1, ``faces = "paper"``,
 ``face_membrane = "paper"``, ``contact_search = "same-x"``), ``averaged`` (the same with
-``face_membrane = "averaged"``, see docs/beam_vs_2d.md), ``L1``…``L6`` (every element at that
+``face_membrane = "averaged"``, see docs/comparisons.md), ``L1``…``L6`` (every element at that
 core level, docs/beam_element.md "Core levels", with the scene defaults: stretch faces, averaged
 membrane, closest-point contact) and ``auto`` (``core = "auto"``, the scene default: levels from
 the error indicator, the path rerun to check them).

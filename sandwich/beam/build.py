@@ -135,16 +135,16 @@ def build_model(
     face_membrane
         ``"paper"``: the faces' ε_x of eq. (15) at every Gauss point. ``"averaged"`` (departs
         from the paper): the faces' ε_x is its element mean along x (assumed membrane strain;
-        removes membrane locking, see docs/beam_vs_2d.md). Default: the scene's
+        removes membrane locking, see docs/comparisons.md). Default: the scene's
         ``[beam_model] face_membrane`` (``"averaged"``).
     contact_search
         Pairing on debonded stretches (:func:`~sandwich.beam.contact_search.contact_pairs`):
         ``"same-x"`` (the paper's closest-node rule under small sliding): each untied face
         node against the core point of the same x; ``"closest-point"``: the node projected on
         the deformed core boundary curve (node-to-segment, consistent linearisation, continuous
-        beyond the search reach, docs/contact_search.md). Default: the scene's
+        beyond the search reach, docs/contact.md). Default: the scene's
         ``[beam_model] contact_search`` (``"closest-point"``: with the faces' stretch and core
-        levels ≥ 3 the same-x pairing stalls on fig. 5, docs/beam_vs_2d.md).
+        levels ≥ 3 the same-x pairing stalls on fig. 5, docs/comparisons.md).
     contact_reach
         Closest-point search: the segments within this distance (mm) on each side of a node, at
         least one per side, are searched (default ``DEFAULT_REACH``).

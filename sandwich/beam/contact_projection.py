@@ -23,7 +23,7 @@ switches at equal distance, where g = ±|r| agrees. If no candidate counts (slid
 searched reach) the pair is flagged ``outside`` and held at the nearer end of the searched
 stretch at fixed ξ (ξ_q = 0): its gap n·r is the distance to the tangent line at that end, equal
 to the projection's gap when the projection leaves through that end (r ∥ n there), so g stays
-continuous and C¹ (g̃_ξ = 0 there) along any motion (docs/contact_search.md: the earlier
+continuous and C¹ (g̃_ξ = 0 there) along any motion (docs/contact.md: the earlier
 fallback, an extrapolated "least outside" segment, made the c3 cantilever's internal force jump).
 The gap along the slave's deformed normal n = s_n (−c, a)/ℓ, ℓ = |X_ξ|, is
 

@@ -4,7 +4,7 @@ Nodes strictly inside a debond are untied; at each of them the face's inner surf
 (master) meets the core's boundary curve (slave). Two searches (``contact_pairs(search=)``):
 
 * ``"closest-point"`` (option of ``contact_search`` in :func:`sandwich.beam.build.build_model`,
-  docs/contact_search.md): node-to-segment. The master point is projected on the deformed core
+  docs/contact.md): node-to-segment. The master point is projected on the deformed core
   boundary curve, the gap is measured along the slave's deformed normal at the projection, and
   the linearisation includes the motion of the projection point
   (:mod:`sandwich.beam.contact_projection`).

@@ -68,7 +68,7 @@ _NO_DATA = np.empty(0)
 
 
 SUM_FACTORISATION = "auto"  # "auto" (by flops, below), "always" (where the rows factor), "never"
-# auto: factored when its flops × this < the packed kernel's. Measured (docs/beam_speed.md,
+# auto: factored when its flops × this < the packed kernel's. Measured (docs/speed.md,
 # machine B, 2026-12-05): the paper's core (2.2× fewer flops) force + tangent 0.79-0.85 against
 # 1.0 ms at 240 elements, fig. 5's path 6-10 % faster; the paper's faces (1.4×) slower factored
 # (0.19 against 0.145 ms); from level 2 on (3.7× and more) factored is far faster. (3.0 until

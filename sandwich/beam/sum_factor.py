@@ -24,7 +24,7 @@ gradients' and the force's contractions run over a block of elements at once, as
 the element index inside ((function, element) rows, (element, point) columns): per element they
 were loops of n_ξ over a handful of functions, bound by loop overhead (level 2, 240 elements:
 the force 0.96 → 0.44 ms, force + tangent 3.45 → 3.02 ms; level 3: the force 1.00 → 0.73 ms,
-force + tangent 7.5 → 7.1-7.4 ms, within the spread between processes; docs/beam_speed.md).
+force + tangent 7.5 → 7.1-7.4 ms, within the spread between processes; docs/speed.md).
 
 The DOF set need not be a full tensor product (the paper's core has no (H̄, H̄_t) DOF): each
 DOF is one (i, j) of the grid of its field's x- and z-functions, the grid's other entries are

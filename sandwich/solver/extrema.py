@@ -3,7 +3,7 @@
 A load extremum (limit point) used to be reported at the converged state with the extreme load
 factor: below a maximum by ½ |λ''| δ², δ the distance from the state to the true top — second
 order in the step, and on long steps not small (fig. 7 c1 as shipped: its top state λ 762.7
-between 555.9 and 706.8; docs/beam_speed.md).
+between 555.9 and 706.8; docs/speed.md).
 
 Each converged state already has the load tangent t = K⁻¹ f_ref (the next step's predictor), so
 the load curve's slope there comes free: along the equilibrium path K du = f_ref dλ, so the

@@ -16,7 +16,7 @@ that needs the JIT, so code paths that never do (no kernel evaluated, or every c
 ahead-of-time build below) do not pay it.
 
 **Ahead-of-time build.** Loading numba and its cached kernels costs ≈ 0.5-0.6 s per process
-(``import numba``, its target initialisation, each kernel's cache entry; docs/beam_speed.md),
+(``import numba``, its target initialisation, each kernel's cache entry; docs/speed.md),
 more than a whole small scene's path. ``make setup`` therefore also compiles every kernel, for the
 argument types a representative workload meets, into one extension module with numba's AOT
 compiler (``scripts/build_kernels.py`` → ``sandwich/solver/_kernels_aot*.so`` and its manifest

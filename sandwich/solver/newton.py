@@ -49,7 +49,7 @@ a system with ``correction_limit(u, du)`` may shorten a correction to the fracti
 contact stiffness for it, and a correction that closes it is blind to the penalty it meets:
 fig. 7 c4 at core level 3 puts 14-59 pairs 0.1-0.2 mm deep into the core in one correction,
 the residual grows by 400-1500×, the next corrections push them out and back in, and the step
-is cut — down to 0.08-0.17 mm of tip deflection (docs/beam_speed.md, "Contact-limited
+is cut — down to 0.08-0.17 mm of tip deflection (docs/speed.md, "Contact-limited
 corrections"). Shortened so that no open pair goes deeper than the penetration bound, the
 correction leaves those pairs where the next tangent sees them. Only a corrector's first
 :data:`LIMITED_CORRECTIONS` corrections are limited (the overshoot comes from the predictor);

@@ -1,4 +1,4 @@
-"""The ``face_membrane="averaged"`` option (not the paper's element; see docs/beam_vs_2d.md).
+"""The ``face_membrane="averaged"`` option (not the paper's element; see docs/comparisons.md).
 
 References: central finite differences of the force and of the energy (consistency of the
 tangent), the closed-form element mean of ½ w,x² (definition of the assumed strain), and the

@@ -1,6 +1,6 @@
 """Interface-tie mismatch of the paper's element: where it vanishes, its order, its soft-core scale.
 
-Reference: ``docs/tie_mismatch.md`` and ``studies/tie_mismatch.py``. At bonded nodes the
+Reference: ``docs/beam_element.md`` and ``studies/tie_mismatch.py``. At bonded nodes the
 element ties u_c = u_face, w_c = w_face, w_c,x = w_face,x; inside an element the face's u is linear
 and the core's boundary u cubic with its own slope DOF, so the slip δu = u_core − u_face is zero at
 the nodes only, while δw is zero everywhere (same Hermite functions, same nodal data). Between

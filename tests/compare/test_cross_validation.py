@@ -21,7 +21,7 @@ extremes within 16 % of the 2D's largest magnitude):
 
 What changed after the first runs, and is said here: the fig5 case first ran to w = −5 mm and
 failed; it runs to −2 mm (before the debonded face buckles), and the −5 mm run, a strict xfail
-while the paper's element alone stayed about 7 % stiffer there (docs/beam_vs_2d.md), is a test
+while the paper's element alone stayed about 7 % stiffer there (docs/comparisons.md), is a test
 again since the core hierarchy closed the gap to 1-1.5 %. Stress peaks were
 first compared raw, which is meaningless at the singular points named above.
 """

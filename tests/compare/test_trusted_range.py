@@ -1,6 +1,6 @@
 """The beam element's trusted range (issue #6), pinned at its edges.
 
-The range is the one measured by the stability map ``docs/extremes.md`` (``benchmarks/
+The range is the one measured by the stability map ``docs/studies.md`` (``benchmarks/
 extremes.py``: the fig5 scene swept over E_core/E_face, t_core/t_face, L/h, debond length and
 load level). Three parts:
 
@@ -27,12 +27,12 @@ load level). Three parts:
 2. **Nonlinear, convergence** (default suite, 60 elements, a few seconds each): the sweep's edge
    scenes where the beam converged in the map, followed to their full target. Asserted: the path
    reaches the target, every state is finite, λ > 0 at the end. No agreement is asserted here: at
-   60 elements the paper's element locks in membrane (docs/beam_vs_2d.md §1; e.g. t_core/t_face =
+   60 elements the paper's element locks in membrane (docs/comparisons.md §1; e.g. t_core/t_face =
    100: λ(−15 mm) = 1126 at 60 elements, 822 at 240).
 
 3. **Nonlinear, at the map's settings** (240 graded elements): the beam reaches the target at
    the edges (the cheap ones in the default suite, debond 0.9 span and load ×2 ``heavy``; load ×2
-   was a strict xfail until 2026-12-04, its path retracing at a load maximum, docs/extremes.md
+   was a strict xfail until 2026-12-04, its path retracing at a load maximum, docs/studies.md
    point 7); and
    (``heavy``) beam and 2D reference at level coarse, both run here, on the edge cases the map
    found in agreement: the load curves must agree within the class the map put them in (3 % or
@@ -128,7 +128,7 @@ def test_thick_face_theory_reduces_to_the_classical_formula():
 # -- nonlinear: the sweep's scenes -----------------------------------------------------------------
 
 def sweep_scene(sweep: str, value: float) -> Scene:
-    """The map's scene; core level 1: the map (docs/extremes.md) is the paper's element's."""
+    """The map's scene; core level 1: the map (docs/studies.md) is the paper's element's."""
     base = load_scene(ROOT / "scenes" / f"{extremes.BASE}.toml")
     base = dataclasses.replace(base, beam_model=dataclasses.replace(base.beam_model, core=1))
     return next(sc for sw, v, sc in extremes.cases(base, [sweep]) if math.isclose(v, value))
@@ -165,7 +165,7 @@ def test_beam_converges_at_the_edges_of_the_map(sweep, value):
 
 # -- heavy: the map's settings, against the 2D model ----------------------------------------------
 
-MAP_ELEMENTS, MAP_LEVEL = 240, "coarse"  # the settings of the map in docs/extremes.md
+MAP_ELEMENTS, MAP_LEVEL = 240, "coarse"  # the settings of the map in docs/studies.md
 AGREEING_EDGES = [  # (sweep, value, L2 class of the map, least common range / target)
     ("stiffness", 1e-1, 0.03, 0.6),  # the 2D path stops at 64 % of the target (see the map)
     ("stiffness", 1e-5, 0.03, 1.0),
@@ -195,7 +195,7 @@ MAP_CONVERGED_EDGES = [  # cheap at 240 elements (~1-2 s each unloaded): default
     ("stiffness", 1e-5), ("thickness", 100), ("slenderness", 20),
     pytest.param("debond", 0.9, marks=pytest.mark.heavy),  # 255 steps
     # load ×2: was a strict xfail (the path retraced at a load maximum); it goes forward to −30 mm
-    # since the probe rescue and the current element defaults (docs/extremes.md point 7)
+    # since the probe rescue and the current element defaults (docs/studies.md point 7)
     pytest.param("load", 2.0, marks=pytest.mark.heavy),
 ]
 

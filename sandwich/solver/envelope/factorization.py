@@ -13,7 +13,7 @@ is refused too it falls back to SuperLU's pivoting LU
 pivot-free LDLᵀ, the same factorisation under the same tests. LAPACK has no banded LDLᵀ with
 pivoting for indefinite matrices: ``dpbtrf`` (banded Cholesky) fails on every state past the
 first bifurcation and ``dgbtrf`` (banded LU with row interchanges) gives only the sign of det K,
-not the count of negative eigenvalues (docs/beam_speed.md).
+not the count of negative eigenvalues (docs/speed.md).
 
 The storage is loaded from the CSR values by runs of consecutive slots
 (:attr:`~.structure.EnvelopeStructure.runs`, :func:`load_values`) into an array reused while no

@@ -6,7 +6,7 @@ the pattern, but its rows are factorised from where their *values* start
 in most states — a closest-point contact pair couples its face node to every searched core
 segment, its tangent lives on the chosen one only, and an open pair's is zero — and the factor
 has no fill before a row's first non-zero (the same L and D, fewer operations: fig. 5 at core
-level 1, 240 elements, 3.2 → 1.3 ms per factorisation, docs/beam_speed.md).
+level 1, 240 elements, 3.2 → 1.3 ms per factorisation, docs/speed.md).
 
 :func:`record_pivot` keeps the statistics the trust tests read; the column and panel kernels
 (:mod:`.columns`, :mod:`.panels`) keep them with it too.

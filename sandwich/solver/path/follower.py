@@ -37,7 +37,7 @@ __all__ = ["DIVERGENCE_RISES", "PathFollower", "follow_path", "solve_linear"]
 
 #: The corrector's rising test (``NewtonSettings.divergence_rises``) on a step's attempts until
 #: one fails by it; the retries of that step, the target's and the rescue's correctors run without,
-#: and the rest of the path once a corrector converged after rising so (docs/beam_speed.md,
+#: and the rest of the path once a corrector converged after rising so (docs/speed.md,
 #: "Corrector attempts that diverge").
 DIVERGENCE_RISES = 2
 
