@@ -158,10 +158,14 @@ class Probe:
 
 
 @dataclass(frozen=True)
-class Analysis:
-    """What to solve and how far: the load factor λ multiplies every load's force."""
+class PathControls:
+    """How a path is followed and how far: the part of ``[analysis]`` the path follower takes.
 
-    kind: str = "nonlinear"
+    :class:`Analysis` is these and the analysis ``kind``; the solver's
+    :class:`~sandwich.solver.path.PathOptions` is these and its own settings, so that neither
+    lists them again.
+    """
+
     control: str = "load"
     until_probe: str | None = None
     until_value: float | None = None
@@ -177,6 +181,13 @@ class Analysis:
     # (sandwich.solver.critical, sandwich.solver.extrema); off: located from the step's two
     # states alone (free; second order in the step for a bifurcation, fourth for an extremum)
     locate_critical_points: bool = False
+
+
+@dataclass(frozen=True)
+class Analysis(PathControls):
+    """What to solve and how far: the load factor λ multiplies every load's force."""
+
+    kind: str = "nonlinear"  # "linear" | "nonlinear"
 
 
 @dataclass(frozen=True)

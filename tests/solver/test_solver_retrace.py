@@ -12,6 +12,8 @@ displacement increment is antiparallel to the previous one, it is refused and cu
 passes the maximum and the minimum and reaches w = 3h with w increasing.
 """
 
+import dataclasses
+
 import numpy as np
 from solver_toys import VonMisesTruss
 
@@ -62,7 +64,7 @@ def test_guard_refuses_a_reversed_step_with_its_reason():
     assert f.turns_back(np.array([0.005]), np.array([0.005])) == ""
     why = f.turns_back(np.array([-0.005]), np.array([0.005]))
     assert why.startswith(RETRACE) and "180°" in why
-    f.opt.control = "arc-length"
+    f.opt = dataclasses.replace(f.opt, control="arc-length")  # options are frozen
     f.sigma = 1.0
     f.turns_back(np.array([-0.005]), np.array([-0.005]))  # the predictor pointed back too
     assert f.sigma == -1.0

@@ -5,14 +5,16 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from sandwich.scene import CONTROLS, Analysis
+from sandwich.scene import CONTROLS, Analysis, PathControls
 
 __all__ = ["ANALYSIS_FIELDS", "CONTROLS", "PathOptions"]
 
 
-@dataclass
-class PathOptions:
+@dataclass(frozen=True)
+class PathOptions(PathControls):
     """How to follow the path and when to stop.
+
+    The scene's :class:`~sandwich.scene.PathControls` and the solver's own settings.
 
     Attributes
     ----------
@@ -80,16 +82,6 @@ class PathOptions:
         fourth for an extremum, :meth:`~.critical_points.CriticalPoints.locate_extremum`).
     """
 
-    control: str = "load"
-    until_load_factor: float | None = None
-    until_probe: str | None = None
-    until_value: float | None = None
-    max_steps: int = 200
-    initial_increment: float | None = None
-    min_increment: float | None = None
-    max_increment: float | None = None
-    tol: float = 1e-8
-    max_iterations: int = 25
     desired_iterations: int = 5
     settling_allowance: int | None = None
     control_probe: str | None = None
@@ -101,7 +93,6 @@ class PathOptions:
     target_tol: float = 1e-6
     target_accept: float = 1e-3
     stop_at_load_reversal: bool = False
-    locate_critical_points: bool = False
 
     @classmethod
     def from_analysis(cls, analysis: Analysis, **overrides: object) -> PathOptions:
@@ -139,7 +130,6 @@ class PathOptions:
         return self.control_probe or self.until_probe
 
 
-#: The fields of :class:`sandwich.scene.Analysis` that :meth:`PathOptions.from_analysis` takes
-#: (those that are path options too: all but the analysis ``kind``).
-ANALYSIS_FIELDS = tuple(f.name for f in dataclasses.fields(Analysis)
-                        if f.name in {g.name for g in dataclasses.fields(PathOptions)})
+#: The fields of :class:`sandwich.scene.Analysis` that :meth:`PathOptions.from_analysis` takes:
+#: its :class:`~sandwich.scene.PathControls` (all but the analysis ``kind``).
+ANALYSIS_FIELDS = tuple(f.name for f in dataclasses.fields(PathControls))
