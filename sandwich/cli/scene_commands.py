@@ -73,6 +73,8 @@ def written_files(folder: Path) -> str:
     """The result files in ``folder``, the field frames counted: what a solve wrote there."""
     from sandwich.results.writing import is_result_file
 
+    if not folder.is_dir():  # an MPI rank other than 0 writes nothing
+        return ""
     names = sorted(p.name for p in folder.iterdir() if is_result_file(p.name))
     frames = [n for n in names if n.startswith("fields_") and n.endswith(".vtu")]
     shown = [n for n in names if n not in frames]
