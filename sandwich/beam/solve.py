@@ -24,7 +24,7 @@ from sandwich.beam.linear_step import linear_solution, toward_target
 from sandwich.beam.model import BeamModel
 from sandwich.beam.path_pass import follow_penalised
 from sandwich.beam.solution import beam_solution, growth_summary
-from sandwich.results import Solution
+from sandwich.results import InterruptedSolve, Solution
 from sandwich.scene import Scene
 from sandwich.solver import PathState
 
@@ -79,7 +79,7 @@ def run(
     limit_points = []
     raised: list[float] = []
     warnings: list[str] = []
-    capped = False
+    capped = interrupted = False
     if not nonlinear:
         model = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene),
                             **{**options, "core_level": choice.levels})
@@ -88,7 +88,15 @@ def run(
     else:
         if choice.how == "auto":
             controller = CoreController(scene, elements, options, choice, progress, auto)
-            path = controller.run()
+            try:
+                path = controller.run()
+            except KeyboardInterrupt:
+                if controller.kept is None:  # no pass reached the target yet: nothing to keep
+                    raise
+                path, interrupted = controller.kept.path, True
+                choice.levels, choice.estimate = controller.kept.levels, None
+                warnings.append("interrupted while checking the core levels: this is the pass "
+                                "that reached the target, its error not estimated")
             capped = controller.capped
         else:
             path = follow_penalised(scene, elements, {**options, "core_level": choice.levels},
@@ -127,6 +135,8 @@ def run(
         "tolerance": getattr(bm, "tolerance", None) if choice.how == "auto" else None,
     }
     solution.wall_seconds = time.perf_counter() - t0
+    if interrupted:
+        raise InterruptedSolve(solution)
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
 
 

@@ -23,7 +23,7 @@ from sandwich.cli.common import (
     say,
 )
 from sandwich.models import mpi_rank, run_model
-from sandwich.results import check_output_folder
+from sandwich.results import InterruptedSolve, check_output_folder
 from sandwich.scene import Scene
 
 __all__ = ["LARGE_BEAM", "cmd_mesh", "cmd_solve", "cmd_validate", "warnings_before_solve"]
@@ -128,6 +128,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     try:
         with PathProgress(scene, f"{scene.name} [{args.model}]", quiet=quiet) as bar:
             sol = run_model(scene, args.model, out, progress=_StepBar(bar))
+    except InterruptedSolve:
+        print("interrupted while checking the core levels: the pass that reached the target is "
+              f"written to {out}/ (its error not estimated)", file=sys.stderr)
+        return EXIT_STOPPED
     except KeyboardInterrupt:
         steps = _steps_written(out)
         print("interrupted before any step converged: an empty history is written to "

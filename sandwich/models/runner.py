@@ -23,6 +23,7 @@ from pathlib import Path
 from sandwich.fracture import growth_onset, missing_releases
 from sandwich.models.registry import get_model
 from sandwich.results import (
+    InterruptedSolve,
     OutputError,
     PathNote,
     ProgressItem,
@@ -165,6 +166,14 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
     t0 = time.perf_counter()
     try:
         solution = solve(scene, progress=on_state)
+    except InterruptedSolve as exc:  # the model kept a whole answer: written, never reused
+        kept = exc.solution
+        kept.extra[IDENTITY_KEY] = {**identity.to_dict(), "complete": False}
+        if mpi_rank() == 0:
+            _write(kept, folder, scene)
+        say(ProgressEvent(model, "interrupted", step=len(kept.history),
+                          message="; ".join([kept.message, *kept.warnings])))
+        raise
     except KeyboardInterrupt:
         partial = _partial(model, scene, streamed, time.perf_counter() - t0)
         partial.extra[IDENTITY_KEY] = {**identity.to_dict(), "complete": False}

@@ -42,6 +42,18 @@ class StateLike(Protocol):
     extra: dict[str, float | None]
 
 
+class InterruptedSolve(KeyboardInterrupt):
+    """An interrupt (Ctrl-C) that reached a model holding a whole answer: ``solution``.
+
+    The beam's ``auto`` core levels raise it when interrupted while checking a pass that
+    reached the target: that pass is the answer, its error not estimated (said in its warnings).
+    """
+
+    def __init__(self, solution: Solution):
+        super().__init__("interrupted; an answer that reached the target is kept")
+        self.solution = solution
+
+
 @dataclass(frozen=True)
 class PathNote:
     """What a model tells while it solves, besides its states: the path starts again.

@@ -1,0 +1,43 @@
+"""Ctrl-C while ``auto`` checks a pass that reached the target: that pass is the written answer.
+
+Reference by construction: the check (the second path pass) is interrupted at its start; the
+first pass reached the target, so the result folder holds its whole answer (profiles, the core
+section, converged) with a warning that its error was not estimated, and is never reused.
+"""
+
+import json
+from pathlib import Path
+
+import pytest
+
+import sandwich.beam.core_controller as core_controller
+from sandwich.models import run_model, with_options
+from sandwich.results import InterruptedSolve
+from sandwich.scene_file import load_scene
+
+FIG5 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
+
+
+def test_an_interrupt_during_the_check_keeps_the_pass_that_reached_the_target(
+        tmp_path, monkeypatch):
+    scene = with_options(load_scene(FIG5), "beam", elements=60)
+    calls = []
+    follow = core_controller.follow_penalised
+
+    def interrupted_second(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return follow(*args, **kwargs)
+
+    monkeypatch.setattr(core_controller, "follow_penalised", interrupted_second)
+    with pytest.raises(InterruptedSolve):
+        run_model(scene, "beam", tmp_path / "beam")
+    assert len(calls) == 2  # the first pass, then the check it was interrupted in
+    summary = json.loads((tmp_path / "beam" / "summary.json").read_text())
+    assert summary["converged"] is True
+    assert summary["core"]["estimated_error"] is None
+    assert any("interrupted while checking the core levels" in w for w in summary["warnings"])
+    assert summary["identity"]["complete"] is False  # never reused
+    profiles = (tmp_path / "beam" / "profiles.csv").read_text().splitlines()
+    assert len(profiles) > 2
