@@ -12,7 +12,9 @@ converged step where it is reached (or none, with the largest G/G_c of the path)
 
 from __future__ import annotations
 
-from sandwich.results import StepRecord
+import math
+
+from sandwich.results import LimitPoint, StepRecord
 from sandwich.results.fracture import column_names, is_release_column
 from sandwich.scene import Scene, Toughness
 
@@ -70,6 +72,46 @@ def missing_releases(history: list[StepRecord]) -> str:
             if r.extra.get(n) is None:
                 where.setdefault(n, []).append(r.step)
     return "; ".join(f"{n} at step(s) {_steps(s)}" for n, s in where.items())
+
+
+NEAR_CRITICAL = 0.9  # G at a load at least this fraction of the next critical load is flagged
+
+
+def ill_conditioned_releases(history: list[StepRecord], limit_points: list[LimitPoint],
+                             fraction: float = NEAR_CRITICAL) -> str:
+    """Where G was evaluated close below the path's first critical load, and how steep it is.
+
+    Approaching a bifurcation or a load maximum λc, G grows steeply with λ: a small error in
+    either model's λc becomes a large one in G there (fig. 5 near its bifurcation: 0.1 % in λc,
+    ≈ 10 % in G). The states before the first critical point whose λ ≥ ``fraction`` × λc and
+    that carry G are named, with the steepest local exponent s of G ∝ λ^s between two such
+    states (1 % of load is ≈ s % of G); ``""`` if there are none.
+    """
+    critical = [lp for lp in limit_points if lp.kind in ("bifurcation", "max")
+                and lp.load_factor > 0]
+    if not critical:
+        return ""
+    first = min(critical, key=lambda lp: (lp.step, lp.load_factor))
+    lam_c = float(first.load_factor)
+    names = sorted({k for r in history for k in r.extra if k.startswith("G_")
+                    and is_release_column(k)})
+    near = [r for r in history if r.step <= first.step and fraction * lam_c <= r.load_factor
+            < lam_c and any(r.extra.get(n) for n in names)]
+    if not near:
+        return ""
+    steep = 0.0
+    for a, b in zip(history, history[1:], strict=False):
+        if b not in near or not 0 < a.load_factor < b.load_factor:
+            continue
+        for n in names:
+            ga, gb = a.extra.get(n), b.extra.get(n)
+            if ga and gb and ga > 0 and gb > 0:
+                steep = max(steep, math.log(gb / ga) / math.log(b.load_factor / a.load_factor))
+    how = f"; G ∝ λ^{steep:.3g} there at its steepest" if steep > 0 else ""
+    return (f"G at step(s) {_steps([r.step for r in near])} is within "
+            f"{100 * (1 - fraction):.0f} % below the first critical load (the {first.kind} at "
+            f"λ {lam_c:.6g}): it is ill-conditioned there — a small error in the critical load "
+            f"is a large one in G{how}")
 
 
 def _steps(steps: list[int]) -> str:

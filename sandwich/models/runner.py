@@ -20,7 +20,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from sandwich.fracture import growth_onset, missing_releases
+from sandwich.fracture import growth_onset, ill_conditioned_releases, missing_releases
 from sandwich.models.registry import get_model
 from sandwich.results import (
     InterruptedSolve,
@@ -181,6 +181,9 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
             _write(partial, folder, scene)
         say(ProgressEvent(model, "interrupted", step=len(streamed), message=partial.message))
         raise
+    near = ill_conditioned_releases(solution.history, solution.limit_points)
+    if near:  # either model: G close below a critical load
+        solution.warnings.append(near)
     solution.extra[IDENTITY_KEY] = identity.to_dict()
     if mpi_rank() == 0:
         _write(solution, folder, scene)
