@@ -74,18 +74,20 @@ def missing_releases(history: list[StepRecord]) -> str:
     return "; ".join(f"{n} at step(s) {_steps(s)}" for n, s in where.items())
 
 
-NEAR_CRITICAL = 0.9  # G at a load at least this fraction of the next critical load is flagged
+NEAR_CRITICAL = 0.9  # G at a load at least this fraction of the next critical load is looked at
+STEEP_EXPONENT = 4.0  # … and flagged where G grows at least as λ^4 there (1 % of load, 4 % of G)
 
 
 def ill_conditioned_releases(history: list[StepRecord], limit_points: list[LimitPoint],
                              fraction: float = NEAR_CRITICAL) -> str:
-    """Where G was evaluated close below the path's first critical load, and how steep it is.
+    """Where G was evaluated close below the path's first critical load and grows steeply there.
 
-    Approaching a bifurcation or a load maximum λc, G grows steeply with λ: a small error in
-    either model's λc becomes a large one in G there (fig. 5 near its bifurcation: 0.1 % in λc,
-    ≈ 10 % in G). The states before the first critical point whose λ ≥ ``fraction`` × λc and
-    that carry G are named, with the steepest local exponent s of G ∝ λ^s between two such
-    states (1 % of load is ≈ s % of G); ``""`` if there are none.
+    Approaching a bifurcation or a load maximum λc, G may grow steeply with λ: a small error in
+    either model's λc then becomes a large one in G (fig. 5 near its bifurcation: 0.1 % in λc,
+    ≈ 10 % in G). The states before the step of the first critical point whose λ ≥
+    ``fraction`` × λc and that carry G are named where the steepest local exponent s of
+    G ∝ λ^s between two of them (1 % of load is ≈ s % of G) is at least ``STEEP_EXPONENT``;
+    ``""`` otherwise (ordinary growth, G ∝ λ², is not flagged).
     """
     critical = [lp for lp in limit_points if lp.kind in ("bifurcation", "max")
                 and lp.load_factor > 0]
@@ -95,7 +97,7 @@ def ill_conditioned_releases(history: list[StepRecord], limit_points: list[Limit
     lam_c = float(first.load_factor)
     names = sorted({k for r in history for k in r.extra if k.startswith("G_")
                     and is_release_column(k)})
-    near = [r for r in history if r.step <= first.step and fraction * lam_c <= r.load_factor
+    near = [r for r in history if r.step < first.step and fraction * lam_c <= r.load_factor
             < lam_c and any(r.extra.get(n) for n in names)]
     if not near:
         return ""
@@ -107,11 +109,12 @@ def ill_conditioned_releases(history: list[StepRecord], limit_points: list[Limit
             ga, gb = a.extra.get(n), b.extra.get(n)
             if ga and gb and ga > 0 and gb > 0:
                 steep = max(steep, math.log(gb / ga) / math.log(b.load_factor / a.load_factor))
-    how = f"; G ∝ λ^{steep:.3g} there at its steepest" if steep > 0 else ""
+    if steep < STEEP_EXPONENT:
+        return ""
     return (f"G at step(s) {_steps([r.step for r in near])} is within "
             f"{100 * (1 - fraction):.0f} % below the first critical load (the {first.kind} at "
             f"λ {lam_c:.6g}): it is ill-conditioned there — a small error in the critical load "
-            f"is a large one in G{how}")
+            f"is a large one in G (G ∝ λ^{steep:.3g} there at its steepest)")
 
 
 def _steps(steps: list[int]) -> str:

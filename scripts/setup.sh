@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 # libopenblas0-serial: an optimised single-threaded BLAS/LAPACK in place of the reference one
 # (alternatives priority 90 > 10) for numpy, SuperLU and MUMPS; single-threaded so that 2 MPI
 # ranks on 2 cores do not oversubscribe (measured gain in docs/verification.md, "Cost").
-# python3-h5py-mpi: meshio's XDMF reader needs h5py; Debian's is built on the HDF5 dolfinx uses.
+# python3-h5py-mpi: meshio's XDMF reader needs h5py; Debian's is on the HDF5 version dolfinx's is.
 DEBS="python3-dolfinx-real python3-gmsh python3-meshio python3-h5py-mpi python3-scipy python3-matplotlib python3-venv python3-dev gcc libopenblas0-serial"
 missing=""
 for p in $DEBS; do

@@ -90,13 +90,17 @@ def run(
             controller = CoreController(scene, elements, options, choice, progress, auto)
             try:
                 path = controller.run()
-            except KeyboardInterrupt:
-                if controller.kept is None:  # no pass reached the target yet: nothing to keep
+            except KeyboardInterrupt as exc:
+                # a user's Ctrl-C only (a study's time limit, a subclass, goes on up as it is);
+                # nothing to keep before a pass reached the target
+                if type(exc) is not KeyboardInterrupt or controller.kept is None:
                     raise
                 path, interrupted = controller.kept.path, True
-                choice.levels, choice.estimate = controller.kept.levels, None
+                choice.levels, choice.estimate = controller.kept.levels, controller.kept.estimate
                 warnings.append("interrupted while checking the core levels: this is the pass "
-                                "that reached the target, its error not estimated")
+                                "that reached the target" + (
+                                    ", its error not estimated" if choice.estimate is None
+                                    else f", its estimated error {100 * choice.estimate:.2g} %"))
             capped = controller.capped
         else:
             path = follow_penalised(scene, elements, {**options, "core_level": choice.levels},
@@ -108,7 +112,7 @@ def run(
             message += (f" (contact penalty raised from {raised[0]:.4g} to {model.penalty:.4g} "
                         f"N/mm³ in {len(raised)} rerun(s) of the path: the converged states "
                         f"penetrated deeper than {model.penetration_bound():.3g} mm)")
-    if choice.how == "auto" and converged and np.any(choice.levels > 1) and (
+    if choice.how == "auto" and converged and not interrupted and np.any(choice.levels > 1) and (
             choice.estimate is None or choice.estimate > float(bm.tolerance)):
         said = ("could not be estimated" if choice.estimate is None else
                 f"{100 * choice.estimate:.2g} % exceeds the tolerance "

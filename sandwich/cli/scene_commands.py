@@ -147,7 +147,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
                  else f"at step {lp.step}")
         say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
     say(args, f"results in {out}/ ({written_files(out)})")
-    for w in sol.warnings:
+    for w in sol.warnings if mpi_rank() == 0 else ():
         print(f"WARNING: {w}", file=sys.stderr)
     if not sol.converged:
         print(f"stopped before the target: {sol.message}", file=sys.stderr)

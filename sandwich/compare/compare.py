@@ -76,13 +76,14 @@ def _debond_spans(scene: Scene, interface: str | None = None) -> list[tuple[floa
 
 def _critical_markers(cmp: Comparison, model: str, probe: str, scale: float
                       ) -> list[tuple[str, float, float]]:
-    """Markers (label, probe value, load in N) at the critical points ``model`` reported."""
+    """Markers (label, probe value, load in N) at the first bifurcation and maximum of ``model``."""
     summary = cmp.metrics.models.get(model)
     if summary is None:
         return []
-    return [(f"{model} {c.kind} {scale * c.load_factor:.4g} N", float(c.probes[probe]),
-             scale * c.load_factor)
-            for c in summary.critical_loads if probe in c.probes]
+    firsts = [c for kind in ("bifurcation", "max")
+              if (c := summary.first_critical(kind)) is not None and probe in c.probes]
+    return [(f"{model} first {c.kind} {scale * c.load_factor:.4g} N", float(c.probes[probe]),
+             scale * c.load_factor) for c in firsts]
 
 
 def _path_figures(cmp: Comparison) -> None:

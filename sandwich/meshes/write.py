@@ -1,6 +1,6 @@
 """Write a :class:`LayeredMesh`: gmsh ``.msh`` (format 4.1), XDMF for ParaView, lip pairs JSON.
 
-The XDMF holds its data inline (no ``.h5``): h5py is not installed here.
+The XDMF holds its data inline (no ``.h5`` file beside it).
 
 The ``.msh`` is rebuilt from the numpy arrays as a discrete gmsh model, so the file holds exactly
 what ``build_mesh`` returned: one surface per layer, one curve per facet group, one point per named

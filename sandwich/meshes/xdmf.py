@@ -1,9 +1,9 @@
 """A minimal XDMF 3 writer (inline XML data, no HDF5 file beside it) that ParaView opens.
 
 One uniform grid per file: ParaView and VTK's XDMF reader open it, and so does ``meshio.read``
-(with h5py installed, as the ``viz`` extra does). ``pyvista.read`` does not: its XDMF reader
-asks every file for time steps, and meshio refuses a file that has them; read it in pyvista
-as ``pyvista.from_meshio(meshio.read(path))``. Node orderings of ``Quadrilateral_9`` and
+(with h5py installed: ``scripts/setup.sh`` installs Debian's). ``pyvista.read`` does not: its
+XDMF reader asks every file for time steps, and meshio refuses a file that has them; read it
+in pyvista as ``pyvista.from_meshio(meshio.read(path))``. Node orderings of ``Quadrilateral_9`` and
 ``Edge_3`` (VTK's) are the same as gmsh's.
 """
 

@@ -89,7 +89,8 @@ def case_metrics(scene: Scene, sol: Solution) -> dict[str, object]:
     probe = _probe(scene, sol)
     out: dict[str, object] = {"converged": bool(sol.converged), "steps": max(len(sol.history) - 1,
                                                                                 0),
-                              "stop_reason": " ".join(sol.message.split())}
+                              "stop_reason": " ".join(sol.message.split()),
+                              "warnings": list(sol.warnings)}
     hist = sol.history
     k0 = None
     if probe is not None and len(hist) >= 2 and probe in hist[1].probes:

@@ -159,6 +159,7 @@ def figures(study: Study, table: list[dict[str, Any]]) -> list[tuple[str, Any]]:
         groups: dict[tuple, list] = {}
         for r in table:
             groups.setdefault(tuple(r[b.name] for b in study.axes[1:]), []).append(r)
+        two_d_drawn = False  # the 2D values' marks: one legend entry once one is drawn
         for key, rs in groups.items():
             xs = [r[a.name] for r in rs]
             ys = [_num(r.get(show)) for r in rs]
@@ -180,13 +181,15 @@ def figures(study: Study, table: list[dict[str, Any]]) -> list[tuple[str, Any]]:
                 v = _num(r.get("2d_" + q))
                 ref = _ref_value(study, table, r, q) if show == "knockdown" else 1.0
                 if v is not None and ref:  # the 2D knock-down needs the 2D reference too
-                    ax.plot([x], [v / ref], "x", color="red", ms=8)
+                    ax.plot([x], [v / ref], "x", color="red", ms=8,
+                            label=None if two_d_drawn else "the 2D model's value")
+                    two_d_drawn = True
         if study.report.threshold is not None and show == "knockdown":
             ax.axhline(study.report.threshold, color="grey", ls="--", lw=1,
                        label=f"threshold {study.report.threshold:g}")
         ax.set_xlabel(_axis_title(a))
         ax.set_ylabel(label)
-        _legend_of_checks(ax, table, q, two_d_marks=show == "knockdown")
+        _legend_of_checks(ax, table, q)
         if 1 < len(groups) <= 12 or ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)
         ax.set_title(_wrapped(f"{study.name}: {label} over {a.name}"), fontsize=9)
@@ -226,8 +229,10 @@ def figures(study: Study, table: list[dict[str, Any]]) -> list[tuple[str, Any]]:
             if e is not None:
                 ax.annotate(f"{100 * e:+.0f}%", (x, y), xytext=(0, 9), textcoords="offset points",
                             ha="center", fontsize=7, color="red")
-        ax.set_xlim(X[0], X[-1])
-        ax.set_ylim(Y[0], Y[-1])
+        if X[-1] > X[0]:  # a one-value axis keeps the cell's own extent
+            ax.set_xlim(X[0], X[-1])
+        if Y[-1] > Y[0]:
+            ax.set_ylim(Y[0], Y[-1])
         ax.set_xlabel(_axis_title(a))
         ax.set_ylabel(_axis_title(b))
         if ax.get_legend_handles_labels()[0]:
@@ -274,15 +279,11 @@ def _wrapped(title: str, width: int = 90) -> str:
     return "\n".join(textwrap.wrap(title, width))
 
 
-def _legend_of_checks(ax: Any, table: list[dict[str, Any]], q: str, *, two_d_marks: bool) -> None:
-    """Legend entries for the 2D-check markers, only where a case was checked."""
-    checked = [r for r in table if r.get("checked_2d")]
-    if not checked:
-        return
-    ax.plot([], [], "o", ms=11, mfc="none", mec="red", mew=1.5,
-            label=f"checked with the 2D model (beam − 2D error of {q})")
-    if two_d_marks and any(_num(r.get("2d_" + q)) is not None for r in checked):
-        ax.plot([], [], "x", color="red", ms=8, label="the 2D model's value")
+def _legend_of_checks(ax: Any, table: list[dict[str, Any]], q: str) -> None:
+    """The legend entry of the 2D-check circles, only where a case was checked."""
+    if any(r.get("checked_2d") for r in table):
+        ax.plot([], [], "o", ms=11, mfc="none", mec="red", mew=1.5,
+                label=f"checked with the 2D model (beam − 2D error of {q})")
 
 
 def _fmt(values: dict[str, Any]) -> str:

@@ -1,7 +1,8 @@
 """G close below a critical load is flagged as ill-conditioned, with how steep it grows.
 
 Reference by construction: a history whose G follows G = c λ^s exactly (s = 2 far from the
-critical load, s = 8 close to it), so the steepest exponent between two flagged states is 8.
+critical load, s = 8 close to it), so the steepest exponent between two flagged states is 8;
+ordinary growth (s = 2) close to a critical load is not flagged.
 """
 
 import pytest
@@ -20,7 +21,7 @@ def _history():
 
 
 def test_states_within_ten_percent_below_the_bifurcation_are_named_with_the_exponent():
-    crit = [LimitPoint("bifurcation", 8, 610.0, {"w": -6.1})]
+    crit = [LimitPoint("bifurcation", 9, 610.0, {"w": -6.1})]  # in the step after state 8
     said = ill_conditioned_releases(_history(), crit)
     assert "step(s) 6, 7, 8" in said  # λ 560, 590, 605 ≥ 0.9 × 610 = 549
     assert "bifurcation at λ 610" in said
@@ -35,8 +36,14 @@ def test_no_critical_point_or_no_g_is_no_warning():
 
 @pytest.mark.parametrize("kind", ["bifurcation", "max"])
 def test_states_after_the_critical_point_are_not_flagged(kind):
-    # located in the step that ends at step 6 (λ 500 → 560): step 5 (λ 500 ≥ 0.9 × 520) is
-    # flagged, the states past the critical load (560, 590, 605) are not
+    # in the step that ends at state 6 (λ 500 → 560): of the states before it only step 5
+    # (λ 500 ≥ 0.9 × 520) is near, and G grows there as λ² (not steep): no warning; the states
+    # past the critical load (560, 590, 605), where G grows as λ^8, are not looked at
     crit = [LimitPoint(kind, 6, 520.0, {})]
-    said = ill_conditioned_releases(_history(), crit)
-    assert said.startswith("G at step(s) 5 is within")
+    assert ill_conditioned_releases(_history(), crit) == ""
+
+
+def test_ordinary_growth_close_to_a_critical_load_is_not_flagged():
+    history = [StepRecord(k, 100.0 * k, {"w": -k}, 3, {"G_0_end": 1e-6 * (100.0 * k) ** 2})
+               for k in range(1, 7)]
+    assert ill_conditioned_releases(history, [LimitPoint("max", 7, 610.0, {})]) == ""
