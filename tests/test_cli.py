@@ -222,3 +222,21 @@ def test_solve_names_every_file_it_wrote(tmp_path, capsys):
                  "fields.pvd"):
         assert name in written and name in line, (name, line)
     assert "fields_*.vtu" in line
+
+
+def test_solve_says_how_accurate_the_run_claims_to_be(tmp_path, capsys):
+    from sandwich.cli import main as cli_main
+
+    scene = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
+    text = scene.read_text().replace('kind = "nonlinear"', 'kind = "linear"')
+    for core, expected in (("1", "no error estimate at a fixed resolution"),
+                           ('"auto"', "estimated error of the core levels")):
+        path = tmp_path / f"s{len(core)}.toml"
+        path.write_text(text + f'\n[beam_model]\ncore = {core}\nelements = 40\n')
+        out = tmp_path / f"r{len(core)}"
+        assert cli_main(["solve", str(path), "--model", "beam", "--out", str(out)]) == 0
+        printed = capsys.readouterr().out
+        assert expected in printed, printed
+        if core == '"auto"':
+            est = json.loads((out / "summary.json").read_text())["core"]["estimated_error"]
+            assert f"{100 * est:.2g} %" in printed

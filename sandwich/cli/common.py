@@ -14,6 +14,7 @@ from pathlib import Path
 
 from sandwich.cli.memory_guard import check_memory
 from sandwich.models import mpi_rank, with_options
+from sandwich.results import Solution
 from sandwich.scene import Scene, SceneError
 from sandwich.scene_file import load_scene
 
@@ -78,6 +79,21 @@ def overridden(scene: Scene, model: str, args: argparse.Namespace) -> Scene:
     if level is not None or refine is not None:
         raise UsageError("options --level/--refine: set the 2D mesh, not the beam's elements")
     return with_options(scene, "beam", elements=elements)
+
+
+def accuracy_line(model: str, sol: Solution) -> str:
+    """What a run says of its own accuracy: the beam's estimate of its core levels, or none."""
+    core = sol.extra.get("core")
+    if not isinstance(core, dict) or core.get("how") != "auto":
+        return (f"{model}: no error estimate at a fixed resolution (compare with another "
+                "resolution, or with the other model: sandwich compare)")
+    est, tol = core.get("estimated_error"), core.get("tolerance")
+    if est is None:
+        return f"{model}: the core levels' error could not be estimated (see the warnings)"
+    met = "within" if tol is not None and est <= tol else "above"
+    return (f"{model}: estimated error of the core levels {100 * est:.2g} % ({met} the "
+            f"tolerance {100 * tol:.2g} %)" if tol is not None else
+            f"{model}: estimated error of the core levels {100 * est:.2g} %")
 
 
 def overridden_both(scene: Scene, args: argparse.Namespace) -> Scene:

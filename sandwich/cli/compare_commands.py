@@ -12,6 +12,7 @@ from sandwich.cli.common import (
     EXIT_OK,
     EXIT_STOPPED,
     RESULTS,
+    accuracy_line,
     guard_memory,
     load_scenes,
     overridden_both,
@@ -58,6 +59,7 @@ def _compare_and_report(args: argparse.Namespace, scene: Scene, out: Path,
     for model, reason in cmp.missing.items():
         print(f"{model}: no result ({reason})", file=sys.stderr)
     for model, sol in cmp.solutions.items():
+        say(args, accuracy_line(model, sol))
         for w in sol.warnings:
             print(f"WARNING ({model}): {w}", file=sys.stderr)
     for line in critical_lines(cmp.metrics, total_force(scene)):

@@ -16,6 +16,7 @@ from sandwich.cli.common import (
     EXIT_OK,
     EXIT_STOPPED,
     RESULTS,
+    accuracy_line,
     default_out,
     guard_memory,
     load_scenes,
@@ -130,7 +131,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
             sol = run_model(scene, args.model, out, progress=_StepBar(bar))
     except InterruptedSolve:
         print("interrupted while checking the core levels: the pass that reached the target is "
-              f"written to {out}/ (its error not estimated)", file=sys.stderr)
+              f"written to {out}/ (its warnings say how far it was checked)", file=sys.stderr)
         return EXIT_STOPPED
     except KeyboardInterrupt:
         steps = _steps_written(out)
@@ -146,6 +147,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
                  f"{lp.between[1]:.6g})" if lp.located_at is not None and lp.between
                  else f"at step {lp.step}")
         say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
+    say(args, accuracy_line(args.model, sol))
     say(args, f"results in {out}/ ({written_files(out)})")
     for w in sol.warnings if mpi_rank() == 0 else ():
         print(f"WARNING: {w}", file=sys.stderr)
