@@ -101,9 +101,10 @@ def ill_conditioned_releases(history: list[StepRecord], limit_points: list[Limit
             < lam_c and any(r.extra.get(n) for n in names)]
     if not near:
         return ""
+    near_steps = {r.step for r in near}
     steep = 0.0
     for a, b in zip(history, history[1:], strict=False):
-        if b not in near or not 0 < a.load_factor < b.load_factor:
+        if b.step not in near_steps or not 0 < a.load_factor < b.load_factor:
             continue
         for n in names:
             ga, gb = a.extra.get(n), b.extra.get(n)

@@ -58,15 +58,18 @@ def cmd_mesh(args: argparse.Namespace) -> int:
 
 
 class _StepBar:
-    """Feeds the runner's step events to a progress bar."""
+    """Feeds the runner's step events to a progress bar; counts the steps past the start."""
 
     def __init__(self, bar):
         self.bar = bar
+        self.steps = 0  # converged steps after the unloaded state 0, as the runner streamed them
 
     def __call__(self, event) -> None:
         if event.phase == "step":
+            self.steps = int(event.step or 0)
             self.bar(event)
         elif event.phase == "note":  # the bar restarts with the path
+            self.steps = 0
             self.bar(SimpleNamespace(step=0, load_factor=0.0, probes={}, message=event.message))
 
 
@@ -82,15 +85,6 @@ def written_files(folder: Path) -> str:
     if frames:
         shown.append(f"{len(frames)} fields_*.vtu frame(s)")
     return ", ".join(shown)
-
-
-def _steps_written(folder: Path) -> int:
-    """Converged steps in ``folder``'s history.csv (0 when it has none or cannot be read)."""
-    try:
-        lines = (folder / "history.csv").read_text().splitlines()
-    except OSError:
-        return 0
-    return sum(1 for ln in lines[1:] if ln.strip() and not ln.startswith("0,"))
 
 
 def warnings_before_solve(scene: Scene, model: str) -> list[str]:
@@ -126,15 +120,17 @@ def cmd_solve(args: argparse.Namespace) -> int:
         print(f"warning: {scene.source}: {line}", file=sys.stderr)
     t0 = time.perf_counter()
     quiet = args.quiet or mpi_rank() != 0
+    feed = None
     try:
         with PathProgress(scene, f"{scene.name} [{args.model}]", quiet=quiet) as bar:
-            sol = run_model(scene, args.model, out, progress=_StepBar(bar))
+            feed = _StepBar(bar)
+            sol = run_model(scene, args.model, out, progress=feed)
     except InterruptedSolve:
         print("interrupted while checking the core levels: the pass that reached the target is "
               f"written to {out}/ (its warnings say how far it was checked)", file=sys.stderr)
         return EXIT_STOPPED
     except KeyboardInterrupt:
-        steps = _steps_written(out)
+        steps = feed.steps if feed is not None else 0
         print("interrupted before any step converged: an empty history is written to "
               f"{out}/" if not steps else
               f"interrupted: the {steps} converged step(s) are written to {out}/",
