@@ -60,8 +60,14 @@ BELOW_FACTOR = 2.0
 
 @dataclass(frozen=True)
 class AutoSettings:
-    """How ``auto`` re-checks the core levels along a path (defaults: the module constants)."""
+    """How ``auto`` re-checks the core levels along a path (defaults: the module constants).
 
+    ``one_pass`` (the default): the levels are checked and raised along one path
+    (:mod:`sandwich.beam.one_pass`); the other fields are the reruns' (:class:`CoreController`),
+    which follow the path again after each raise.
+    """
+
+    one_pass: bool = True
     rechecks: int = CORE_RECHECKS  # raises at most
     rerun_step_factor: int = RERUN_STEP_FACTOR
     rerun_min_steps: int = RERUN_MIN_STEPS
@@ -255,29 +261,8 @@ class CoreController:
 
     def _raised_levels(self, model: BeamModel, last: PathState, levels: np.ndarray,
                        top: int) -> np.ndarray | None:
-        """The levels a rerun checks after ``last``, or None where the zones are at the cap.
-
-        The elements carrying DORFLER_FRACTION of the state shares (:func:`state_shares`) are
-        raised, and so is every element over a debond or a load patch
-        (:func:`local_zone_elements`): the residual points at singular spots (debond tips, point
-        supports), where a raise hardly moves the load, while the load error of a buckled
-        debond lives in the contact strip all along it (fig. 5: residual shares 81 % at the
-        tips, load change there 0.5 %, true error 12 %). None when those zones cannot be raised:
-        a rerun would raise only elements where the load error does not live, and its small
-        change would read as convergence (demo scene: 0.05 % for a true 4.8 %).
-        """
-        up = build_model(self.scene, elements=self.elements, gauss=scene_gauss_orders(self.scene),
-                         **{**self.options, "core_level": lookahead_levels(levels)})
-        shares = state_shares(model, last.u, last.load_factor, up)
-        marked = raise_levels(levels, shares, DORFLER_FRACTION * shares.sum(), top)
-        zone = np.minimum(levels + 1, top)
-        inside = local_zone_elements(self.scene, model)
-        # no level change next to a debond tip: it biases G (docs/fracture.md)
-        raised = uniform_tip_levels(model, beam_tips(self.scene, model),
-                                    np.where(inside, np.maximum(marked, zone), marked))
-        if np.any(inside) and not np.any(raised[inside] > levels[inside]):
-            return None
-        return raised
+        """The levels a rerun checks after ``last`` (:func:`raised_levels`)."""
+        return raised_levels(self.scene, self.elements, self.options, model, last, levels, top)
 
     def check_end_states(self, path: PathPass, levels: np.ndarray, tol: float,
                          top: int) -> EndStateChecks:
@@ -353,28 +338,63 @@ class CoreController:
                              None)
 
     def fallback(self, path: PathPass) -> PathPass:
-        """``path``, or the path at level 1 where the one at the chosen levels stopped short.
+        """``path``, or the path at level 1 where it stopped short (:func:`level_1_fallback`)."""
+        return level_1_fallback(self.scene, self.elements, self.options, self.choice, path,
+                                self.progress)
 
-        The paper's element is the fallback (extremes map: thin faces, L/h = 5 and load x2
-        reach their target only at level 1); the choice and the message say so.
-        """
-        choice = self.choice
-        if path.converged or not np.any(choice.levels > 1):
-            return path
-        stopped = path.message
-        level_1 = follow_penalised(self.scene, self.elements, {**self.options, "core_level": 1},
-                                   self.progress)
-        if not level_1.converged:
-            return path
-        choice.levels = np.ones_like(choice.levels)
-        choice.estimate = None
-        choice.passes.append({"stage": "fallback to level 1",
-                              "elements_per_level": level_counts(choice.levels),
-                              "load_factor": level_1.last.load_factor, "reached": True,
-                              "estimate": None})
-        return dataclasses.replace(level_1, warnings=[*level_1.warnings, (
-            f"with auto core levels the path stopped ({stopped}); this is the "
-            "paper's element (core level 1), its error not estimated")])
+
+def level_1_fallback(scene: object, elements: int | None, options: dict, choice: LevelChoice,
+                     path: PathPass, progress: Callable[[object], None] | None) -> PathPass:
+    """``path``, or the path at level 1 where the one at the chosen levels stopped short.
+
+    The paper's element is the fallback (extremes map: thin faces, L/h = 5 and load x2
+    reach their target only at level 1); the choice and the message say so.
+    """
+    if path.converged or not np.any(choice.levels > 1):
+        return path
+    stopped = path.message
+    if progress is not None:
+        progress(PathNote(f"the path at auto core levels stopped ({stopped}); following it "
+                          "again at core level 1"))
+    level_1 = follow_penalised(scene, elements, {**options, "core_level": 1}, progress)
+    if not level_1.converged:
+        return path
+    choice.levels = np.ones_like(choice.levels)
+    choice.estimate = None
+    choice.passes.append({"stage": "fallback to level 1",
+                          "elements_per_level": level_counts(choice.levels),
+                          "load_factor": level_1.last.load_factor, "reached": True,
+                          "estimate": None})
+    return dataclasses.replace(level_1, warnings=[*level_1.warnings, (
+        f"with auto core levels the path stopped ({stopped}); this is the "
+        "paper's element (core level 1), its error not estimated")])
+
+
+def raised_levels(scene: object, elements: int | None, options: dict, model: BeamModel,
+                  last: PathState, levels: np.ndarray, top: int) -> np.ndarray | None:
+    """The levels a check raises to after ``last``, or None where the zones are at the cap.
+
+    The elements carrying DORFLER_FRACTION of the state shares (:func:`state_shares`) are
+    raised, and so is every element over a debond or a load patch
+    (:func:`local_zone_elements`): the residual points at singular spots (debond tips, point
+    supports), where a raise hardly moves the load, while the load error of a buckled
+    debond lives in the contact strip all along it (fig. 5: residual shares 81 % at the
+    tips, load change there 0.5 %, true error 12 %). None when those zones cannot be raised:
+    a check would raise only elements where the load error does not live, and its small
+    change would read as convergence (demo scene: 0.05 % for a true 4.8 %).
+    """
+    up = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene),
+                     **{**options, "core_level": lookahead_levels(levels)})
+    shares = state_shares(model, last.u, last.load_factor, up)
+    marked = raise_levels(levels, shares, DORFLER_FRACTION * shares.sum(), top)
+    zone = np.minimum(levels + 1, top)
+    inside = local_zone_elements(scene, model)
+    # no level change next to a debond tip: it biases G (docs/fracture.md)
+    raised = uniform_tip_levels(model, beam_tips(scene, model),
+                                np.where(inside, np.maximum(marked, zone), marked))
+    if np.any(inside) and not np.any(raised[inside] > levels[inside]):
+        return None
+    return raised
 
 
 def end_change(analysis: object, state: PathState, load_factor: float,

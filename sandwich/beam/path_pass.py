@@ -15,7 +15,7 @@ import numpy as np
 
 from sandwich.beam.build import build_model, scene_gauss_orders
 from sandwich.beam.model import BeamModel
-from sandwich.results import LimitPoint
+from sandwich.results import LimitPoint, PathNote
 from sandwich.solver import PathState
 
 MIN_INCREMENT_PER_SMOOTHING = 0.01  # default path increment floor / contact smoothing width s
@@ -71,9 +71,13 @@ def min_increment(model: BeamModel, analysis: object) -> float | None:
 
 def follow(
     model: BeamModel, scene: object, progress: Callable[[object], None] | None,
-    max_steps: int | None = None,
+    max_steps: int | None = None, refine: object | None = None,
 ) -> PathPass:
     """Follow the nonlinear path of ``scene`` on ``model``.
+
+    ``refine``: the follower's refinement hook (:mod:`sandwich.solver.path.switching`) with
+    the model the path is on as its ``model`` (:class:`~sandwich.beam.one_pass.OnePass`): the
+    pass's model is the one the path ended on.
 
     ``max_steps`` given (an ``auto`` rerun, which checks a pass at lower levels): also stop
     where the path comes back through zero load (``stop_at_load_reversal``): the pass it checks
@@ -90,8 +94,10 @@ def follow(
                                         desired_iterations=DESIRED_ITERATIONS,
                                         settling_allowance=scene.beam_model.settling_allowance,
                                         **caps)
-    result = follow_path(model, options, list(model.probe_rows), progress)
+    result = follow_path(model, options, list(model.probe_rows), progress, refine)
     states = list(result.states)
+    if refine is not None:
+        model = refine.model
     return PathPass(model, states, result.message, result.reached_target,
                     list(result.limit_points), warnings=list(result.warnings))
 
@@ -99,24 +105,31 @@ def follow(
 def follow_penalised(
     scene: object, elements: int | None, options: dict,
     progress: Callable[[object], None] | None, max_steps: int | None = None,
+    refine: Callable[[BeamModel, dict], object] | None = None,
 ) -> PathPass:
     """Follow the path; rerun with a stiffer penalty while converged states penetrate too deep.
 
     ``options``: :func:`~sandwich.beam.build.build_model`'s; ``max_steps`` (default the
-    scene's) caps the steps of each attempt.
+    scene's) caps the steps of each attempt; ``refine(model, options)`` makes each attempt's
+    refinement hook (:func:`follow`).
     """
     raised: list[float] = []
     model = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene), **options)
     while True:
-        path = follow(model, scene, progress, max_steps)
+        hook = None if refine is None else refine(model, options)
+        path = follow(model, scene, progress, max_steps, hook)
+        model = path.model
         pen, bound = states_penetration(model, path.states), model.penetration_bound()
         if pen <= bound or len(raised) == PENALTY_RESTARTS:
             path.penalties_raised = raised
             return path
         raised.append(model.penalty)
         penalty = model.penalty * PENALTY_GROWTH * pen / bound
-        model = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene),
-                            **{**options, "contact_penalty": penalty})
+        options = {**options, "contact_penalty": penalty}
+        if progress is not None:
+            progress(PathNote(f"contact penalty raised to {penalty:.4g} N/mm³: following the "
+                              "path again"))
+        model = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene), **options)
 
 
 def max_penetration(model: BeamModel, displacements: list[np.ndarray]) -> float:

@@ -4,8 +4,10 @@
 :func:`run` also hands back the model and the converged states, for field reconstruction
 (:mod:`sandwich.beam.fields`). The core levels are chosen first
 (:mod:`sandwich.beam.core_choice`); a nonlinear analysis follows the path once at fixed levels
-(:mod:`sandwich.beam.path_pass`), or, with ``auto`` levels, as
-:class:`~sandwich.beam.core_controller.CoreController` re-checks them.
+(:mod:`sandwich.beam.path_pass`), or, with ``auto`` levels, once with the levels checked and
+raised along it (:class:`~sandwich.beam.one_pass.OnePass`; or, with
+``AutoSettings(one_pass=False)``, again after each raise:
+:class:`~sandwich.beam.core_controller.CoreController`).
 """
 
 from __future__ import annotations
@@ -18,11 +20,18 @@ import numpy as np
 
 from sandwich.beam.build import build_model, scene_gauss_orders, scene_model_options
 from sandwich.beam.core_choice import choose_core_levels
-from sandwich.beam.core_controller import AutoSettings, CoreController, path_passes
+from sandwich.beam.core_controller import (
+    AutoSettings,
+    CoreController,
+    level_1_fallback,
+    path_passes,
+)
+from sandwich.beam.core_levels import LevelChoice, level_counts
 from sandwich.beam.fracture import beam_tips, level_warning
 from sandwich.beam.linear_step import linear_solution, toward_target
 from sandwich.beam.model import BeamModel
-from sandwich.beam.path_pass import follow_penalised
+from sandwich.beam.one_pass import OnePass
+from sandwich.beam.path_pass import PathPass, follow_penalised
 from sandwich.beam.solution import beam_solution, growth_summary
 from sandwich.results import InterruptedSolve, Solution
 from sandwich.scene import Scene
@@ -86,7 +95,9 @@ def run(
         states, message = _linear_states(model, scene)
         converged = True
     else:
-        if choice.how == "auto":
+        if choice.how == "auto" and (auto or AutoSettings()).one_pass:
+            path, capped = _one_pass(scene, elements, options, choice, progress)
+        elif choice.how == "auto":
             controller = CoreController(scene, elements, options, choice, progress, auto)
             try:
                 path = controller.run()
@@ -117,7 +128,8 @@ def run(
         said = ("could not be estimated" if choice.estimate is None else
                 f"{100 * choice.estimate:.2g} % exceeds the tolerance "
                 f"{100 * float(bm.tolerance):.2g} %")
-        reruns = f", {path_passes(choice) - 1} rerun(s) of the path" if nonlinear else ""
+        reruns = (f", {path_passes(choice) - 1} rerun(s) of the path"
+                  if nonlinear and path_passes(choice) > 1 else "")
         warnings.append(f"the core's estimated error {said} (max_core_level "
                         f"{bm.max_core_level}{reruns})")
     if capped:
@@ -142,6 +154,33 @@ def run(
     if interrupted:
         raise InterruptedSolve(solution)
     return BeamRun(solution=solution, model=model, states=states, nonlinear=nonlinear)
+
+
+def _one_pass(scene: Scene, elements: int | None, options: dict, choice: LevelChoice,
+              progress: Callable[[object], None] | None) -> tuple[PathPass, bool]:
+    """The path at ``auto`` levels checked and raised along it (:class:`OnePass`); capped.
+
+    Each penalty rerun of the path starts again at the linear step's levels. Where the path
+    stops short, the paper's element is the fallback (:func:`level_1_fallback`).
+    """
+    initial = choice.levels.copy()
+    hooks: list[OnePass] = []
+
+    def hook(model: BeamModel, opts: dict) -> OnePass:
+        choice.levels, choice.estimate = initial.copy(), None
+        hooks.append(OnePass(scene, elements, opts, choice, model, progress))
+        return hooks[-1]
+
+    path = follow_penalised(scene, elements, {**options, "core_level": initial}, progress,
+                            refine=hook)
+    one = hooks[-1]
+    if not one.checked_at_target:
+        choice.estimate = None  # the last check was not at the path's end
+    choice.passes.append({"stage": f"path step {path.last.step}",
+                          "elements_per_level": level_counts(choice.levels),
+                          "load_factor": path.last.load_factor, "reached": path.converged,
+                          "estimate": choice.estimate})
+    return level_1_fallback(scene, elements, options, choice, path, progress), one.capped
 
 
 def _linear_states(model: BeamModel, scene: object) -> tuple[list[PathState], str]:

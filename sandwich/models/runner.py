@@ -154,11 +154,14 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
     streamed: list[StepRecord] = []
 
     def on_state(item: ProgressItem) -> None:
-        if isinstance(item, PathNote):  # the path starts again: its states supersede these
-            streamed.clear()
+        if isinstance(item, PathNote):
+            if item.restart:  # the path starts again: its states supersede these
+                streamed.clear()
             say(ProgressEvent(model, "note", message=item.message))
             return
         rec = StepRecord.of(item)  # the state's columns kept, e.g. G at the tips
+        while streamed and streamed[-1].step >= rec.step:  # re-converged at raised levels
+            streamed.pop()
         streamed.append(rec)
         say(ProgressEvent(model, "step", step=rec.step, load_factor=rec.load_factor,
                           probes=rec.probes))

@@ -56,13 +56,17 @@ class InterruptedSolve(KeyboardInterrupt):
 
 @dataclass(frozen=True)
 class PathNote:
-    """What a model tells while it solves, besides its states: the path starts again.
+    """What a model tells while it solves, besides its states.
 
-    The one other event a model's ``progress`` callback receives; the states streamed before
-    it are superseded (a rerun at raised core levels follows the path from its start).
+    The one other event a model's ``progress`` callback receives. With ``restart`` the path
+    starts again and the states streamed before it are superseded (a rerun at raised core
+    levels follows the path from its start); without, it is news only (levels raised along
+    the path: the state re-converged at them comes next, with the step number of the one it
+    replaces).
     """
 
     message: str
+    restart: bool = True
 
 
 ProgressItem = Union[StateLike, PathNote]  # noqa: UP007 - a runtime alias of a Protocol

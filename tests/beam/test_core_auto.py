@@ -95,12 +95,13 @@ def test_zones_raise_the_levels_and_auto_keeps_them_as_a_floor():
 
 
 def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
-    """Nonlinear bend to −6 mm: the linear step's choice is re-checked at the end of the path;
+    """Nonlinear bend to −6 mm, auto with reruns: the linear step's choice is re-checked at the
+    end of the path;
     a tight tolerance makes it rerun with more levels, and the final estimate is reported.
     (Its raise changes the end load by 0.04 %, under a quarter of the tolerance, which would
     report the checked path itself — test_core_end_state.py; switched off here: the rerun.)"""
     scene = _bend_to_6mm(tolerance=0.003, max_core_level=4)
-    r = run(scene, auto=AutoSettings(below_fraction=0.0))
+    r = run(scene, auto=AutoSettings(one_pass=False, below_fraction=0.0))
     core = r.solution.extra["core"]
     stages = [p["stage"] for p in core["passes"]]
     assert sum(s.startswith("path step") for s in stages) >= 2, stages  # rerun at least once
@@ -109,12 +110,13 @@ def test_the_path_recheck_raises_levels_when_the_large_deflection_needs_them():
 
 
 def test_a_rerun_that_stops_short_keeps_the_pass_it_was_checking():
-    """The rerun's step budget (a multiple of the checked pass's steps) cut to 2 steps: the
-    raised path cannot reach −6 mm, so the answer is the first path pass (its levels, its end
-    load) with a WARNING, and the stopped rerun is listed in the passes."""
+    """Auto with reruns, the rerun's step budget (a multiple of the checked pass's steps) cut
+    to 2 steps: the raised path cannot reach −6 mm, so the answer is the first path pass (its
+    levels, its end load) with a WARNING, and the stopped rerun is listed in the passes."""
     scene = _bend_to_6mm(tolerance=0.003, max_core_level=4)
     # below_fraction 0: a rerun, not the checked path (above)
-    r = run(scene, auto=AutoSettings(below_fraction=0.0, rerun_step_factor=0, rerun_min_steps=2))
+    r = run(scene, auto=AutoSettings(one_pass=False, below_fraction=0.0, rerun_step_factor=0,
+                                     rerun_min_steps=2))
     sol, core = r.solution, r.solution.extra["core"]
     paths = [p for p in core["passes"] if p["stage"].startswith("path step")]
     first, rerun = paths[0], paths[-1]

@@ -1,4 +1,5 @@
-"""``auto`` core levels: a raise is first tried on the checked pass's end state alone.
+"""``auto`` core levels with reruns (``AutoSettings(one_pass=False)``): a raise is first tried on
+the checked pass's end state alone.
 
 The reference is the path itself: the same scene with the end-state checks switched off
 (``AutoSettings(end_state_checks=False)``) follows the whole path again after every raise (the
@@ -29,6 +30,7 @@ from sandwich.beam.core_levels import level_counts
 from sandwich.scene import Analysis
 from sandwich.scene_file import load_scene
 
+RERUN = AutoSettings(one_pass=False)  # the reruns these tests are about
 C1 = Path(__file__).resolve().parents[2] / "scenes" / "paper-fig7-cantilever-c1.toml"
 
 
@@ -40,9 +42,10 @@ def _both(elements):
     """c1 with the checks, and with the reruns after every raise; neither reports the levels
     below a check within half the tolerance (``below_fraction`` 0: that is compared below)."""
     scene = load_scene(C1)
-    checked = run(scene, elements=elements, auto=AutoSettings(below_fraction=0.0))
+    checked = run(scene, elements=elements,
+                  auto=AutoSettings(one_pass=False, below_fraction=0.0))
     rerun = run(scene, elements=elements,
-                auto=AutoSettings(below_fraction=0.0, end_state_checks=False))
+                auto=AutoSettings(one_pass=False, below_fraction=0.0, end_state_checks=False))
     return checked, rerun
 
 
@@ -107,7 +110,7 @@ def test_a_failed_end_state_falls_back_to_following_the_path(monkeypatch, confir
     _, rerun = confirmed
     calls = []
     monkeypatch.setattr(CoreController, "end_state", lambda *args: calls.append(args) or None)
-    r = run(load_scene(C1))
+    r = run(load_scene(C1), auto=RERUN)
     assert len(calls) == 1
     assert not _stages(r, "end state")
     assert [p["load_factor"] for p in _stages(r, "path step")] == [
@@ -120,10 +123,10 @@ def test_no_end_state_check_where_the_path_ended_at_a_load_target():
     and continuing it there would check another state (without the guard: checks at 880.2 for a
     path ending at 853.8); auto reruns the path instead."""
     scene = load_scene(C1.parent / "default.toml")
-    probe_end = run(scene, elements=60).solution.final_load_factor
+    probe_end = run(scene, elements=60, auto=RERUN).solution.final_load_factor
     scene = dataclasses.replace(scene, analysis=dataclasses.replace(
         scene.analysis, until_load_factor=0.97 * probe_end))
-    r = run(scene, elements=60)
+    r = run(scene, elements=60, auto=RERUN)
     assert r.solution.final_load_factor == pytest.approx(0.97 * probe_end, rel=1e-6)
     assert not _stages(r, "end state")
     assert len(_stages(r, "path step")) >= 2  # it still rechecks, by reruns
@@ -145,7 +148,7 @@ def test_a_first_check_far_within_the_tolerance_reports_the_path_it_checked():
     limit) its error is within 1.5 × the tolerance, as test_core_auto asks of auto on the linear
     bend (measured 0.31 %; the raised path would be 0.26 % off — both estimates read low on this
     coarse mesh: 0.09 % and 0.04 %)."""
-    r = run(_bend(0.003))
+    r = run(_bend(0.003), auto=RERUN)
     core = r.solution.extra["core"]
     paths, ends = _stages(r, "path step"), _stages(r, "end state")
     assert len(paths) == 1 and len(ends) == 1, core["passes"]
@@ -160,7 +163,7 @@ def test_a_first_check_far_within_the_tolerance_reports_the_path_it_checked():
     true = abs(r.solution.final_load_factor / limit.solution.final_load_factor - 1)
     assert true <= 1.5 * 0.003, true
     # without the rule the raised path is followed, and it ends where the check said
-    raised = run(_bend(0.003), auto=AutoSettings(below_fraction=0.0))
+    raised = run(_bend(0.003), auto=AutoSettings(one_pass=False, below_fraction=0.0))
     assert len(_stages(raised, "path step")) == 2
     assert raised.solution.final_load_factor == pytest.approx(ends[0]["load_factor"], rel=1e-6)
 
@@ -171,7 +174,7 @@ def test_a_later_check_far_within_the_tolerance_has_the_path_followed_below_it()
     the first check's levels (not the second's), must end at its load, and is the answer with the
     estimate 2 × 0.15 %; without the rule the path at the second check's levels is."""
     scene = load_scene(C1.parent / "default.toml")
-    r = run(scene, elements=120)
+    r = run(scene, elements=120, auto=RERUN)
     core = r.solution.extra["core"]
     paths, ends = _stages(r, "path step"), _stages(r, "end state")
     assert len(paths) == 2 and len(ends) == 2, core["passes"]
@@ -183,6 +186,6 @@ def test_a_later_check_far_within_the_tolerance_has_the_path_followed_below_it()
     assert r.solution.final_load_factor == pytest.approx(ends[0]["load_factor"], rel=1e-6)
     assert core["estimated_error"] == pytest.approx(BELOW_FACTOR * ends[1]["estimate"],
                                                     rel=1e-12)
-    raised = run(scene, elements=120, auto=AutoSettings(below_fraction=0.0))
+    raised = run(scene, elements=120, auto=AutoSettings(one_pass=False, below_fraction=0.0))
     assert level_counts(raised.model.element_levels) == ends[1]["elements_per_level"]
     assert raised.solution.final_load_factor == pytest.approx(ends[1]["load_factor"], rel=1e-6)

@@ -1,4 +1,6 @@
-"""Ctrl-C while ``auto`` checks a pass that reached the target: that pass is the written answer.
+"""Ctrl-C while ``auto`` with reruns checks a pass that reached the target: that pass is the
+written answer (``AutoSettings(one_pass=False)``; the one pass is one path: the runner keeps its
+converged steps, test_one_pass.py).
 
 Reference by construction: the check (the second path pass) is interrupted at its start; the
 first pass reached the target, so the result folder holds its whole answer (profiles, the core
@@ -6,11 +8,13 @@ section with that pass's estimate, converged) with a warning, and is never reuse
 """
 
 import json
+import sys
 from pathlib import Path
 
 import pytest
 
 import sandwich.beam.core_controller as core_controller
+import sandwich.beam.solve  # noqa: F401 - its module, for the monkeypatch below
 from sandwich.models import run_model, with_options
 from sandwich.results import InterruptedSolve
 from sandwich.scene_file import load_scene
@@ -31,6 +35,8 @@ def test_an_interrupt_during_the_check_keeps_the_pass_that_reached_the_target(
         return follow(*args, **kwargs)
 
     monkeypatch.setattr(core_controller, "follow_penalised", interrupted_second)
+    monkeypatch.setattr(sys.modules["sandwich.beam.solve"], "AutoSettings",
+                        lambda: core_controller.AutoSettings(one_pass=False))
     with pytest.raises(InterruptedSolve):
         run_model(scene, "beam", tmp_path / "beam")
     assert len(calls) == 2  # the first pass, then the check it was interrupted in

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from sandwich.beam import run as solve_run
+from sandwich.beam.core_controller import AutoSettings
 from sandwich.scene_file import load_scene
 from sandwich.studies.study_file import load_study
 
@@ -56,13 +57,13 @@ def test_a_maximum_inside_a_long_step_is_located_and_narrowed_to_the_fine_paths_
 
 
 def test_the_top_a_probe_rescue_jumps_over_is_bounded_by_walking_its_branch():
-    # fig. 6 as shipped: at λ 1952.4 the arc collapses where the debonded face is about to
-    # snap, and the probe rescue steps to λ 1915.3 on the branch beyond, both of its tangents
-    # rising. Reference: the same model (its core levels frozen) in displacement steps of at
+    # fig. 6 with auto's reruns (AutoSettings(one_pass=False)): at λ 1952.4 the arc collapses
+    # where the debonded face is about to snap, and the probe rescue steps to λ 1915.3 on the
+    # branch beyond, both of its tangents rising. Reference: the same model (its core levels frozen) in displacement steps of at
     # most 0.2 mm, stalling where that branch ends (the same end state in steps of 0.05 and
     # 0.1 mm: λ 1976.79 at w_bottom −9.6470 mm, to 1e-11; the tangent stays regular up to it).
     scene = load_scene(ROOT / "scenes" / "paper-fig6-top-debond-20-load-bottom.toml")
-    shipped = solve_run(scene)
+    shipped = solve_run(scene, auto=AutoSettings(one_pass=False))
     assert "under control of w_bottom_mid" in shipped.solution.message
     fine_analysis = dataclasses.replace(scene.analysis, control="displacement",
                                         max_increment=0.2, initial_increment=0.2,

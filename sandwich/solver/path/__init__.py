@@ -49,7 +49,8 @@ so in the linear range the λ and u parts of the arc weigh the same.
 Modules: :mod:`.options` (:class:`PathOptions`), :mod:`.records` (:class:`PathState`,
 :class:`PathResult`, :class:`Trial`), :mod:`.state` (what the follower's parts share),
 :mod:`.guards`, :mod:`.attempts`, :mod:`.targets`, :mod:`.step_size`, :mod:`.critical_points`,
-:mod:`.rescue`, and :mod:`.follower` (:class:`PathFollower` composed of those parts, the step
+:mod:`.rescue`, :mod:`.switching` (going on on a finer system a caller's hook hands over),
+and :mod:`.follower` (:class:`PathFollower` composed of those parts, the step
 loop, :func:`follow_path`).
 """
 
@@ -70,7 +71,7 @@ from sandwich.solver.path.guards import (
     ReturnGuard,
 )
 from sandwich.solver.path.options import CONTROLS, PathOptions
-from sandwich.solver.path.records import PathResult, PathState, Trial
+from sandwich.solver.path.records import PathResult, PathState, Refinement, Trial
 from sandwich.solver.path.rescue import (
     RESCUE_FRACTION,
     RESCUE_MEMORY,
@@ -80,6 +81,7 @@ from sandwich.solver.path.rescue import (
     WALK_TRIES,
 )
 from sandwich.solver.path.step_size import BENT, HALF_REACH, SETTLING_BEND, StepSize
+from sandwich.solver.path.switching import RefineHook, SystemSwitch
 from sandwich.solver.path.targets import CRITICAL_TARGET, CRITICAL_TARGET_CUTS, TARGET_SUBSTEP_CUTS
 
 __all__ = [
@@ -108,8 +110,11 @@ __all__ = [
     "PathOptions",
     "PathResult",
     "PathState",
+    "RefineHook",
+    "Refinement",
     "ReturnGuard",
     "StepSize",
+    "SystemSwitch",
     "Trial",
     "follow_path",
     "solve_linear",

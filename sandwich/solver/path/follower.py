@@ -9,7 +9,8 @@ builds on the parts it uses (all on :class:`~.state.FollowerState`, the state th
 - :class:`~.step_size.StepSizeControl` — the first increment and the settling allowance
   (the increment itself: :class:`~.step_size.StepSize`);
 - :class:`~.critical_points.CriticalPoints` — a bifurcation or load extremum inside a step;
-- :class:`~.rescue.RescueSteps` — the probe rescue of a collapsed arc, the branch a step left.
+- :class:`~.rescue.RescueSteps` — the probe rescue of a collapsed arc, the branch a step left;
+- :class:`~.switching.SystemSwitch` — going on on a finer system (the caller's ``refine``).
 
 The return guard is a collaborator (:class:`~.guards.ReturnGuard`). This module holds the loop
 (:meth:`PathFollower.converged_states`) and a step's tries with their cuts
@@ -30,6 +31,7 @@ from sandwich.solver.path.options import PathOptions
 from sandwich.solver.path.records import PathResult, PathState, Trial, format_probes
 from sandwich.solver.path.rescue import RESCUE_MEMORY, RescueSteps
 from sandwich.solver.path.step_size import BENT, StepSize, StepSizeControl
+from sandwich.solver.path.switching import RefineHook, SystemSwitch
 from sandwich.solver.path.targets import CRITICAL_TARGET, CRITICAL_TARGET_CUTS
 from sandwich.solver.system import DiscreteSystem
 
@@ -42,7 +44,7 @@ __all__ = ["DIVERGENCE_RISES", "PathFollower", "follow_path", "solve_linear"]
 DIVERGENCE_RISES = 2
 
 
-class PathFollower(RescueSteps, CriticalPoints, StepSizeControl):
+class PathFollower(RescueSteps, CriticalPoints, StepSizeControl, SystemSwitch):
     """State machine of :func:`follow_path` (one instance per call): the parts composed.
 
     Every method is defined in exactly one part (none overrides another), so the order of the
@@ -121,7 +123,14 @@ class PathFollower(RescueSteps, CriticalPoints, StepSizeControl):
             if (self.rescues and self.rescues[-1] == step) or self.jumped(last, state, t):
                 self.walk_branch_left(state, last, t)
             self.locate_crossing(state, last, fac_before, fac, t)
-            t = t_next
+            switched = self.switch_system(state)
+            if switched is not None:  # the state re-converged on a finer system replaces it
+                fac, t = switched
+                yield self.states[-1]
+                if self.states[-1].step < state.step:
+                    continue  # rewound: the step is taken again on the new system
+            else:
+                t = t_next
             done = self.target_reached()
             if done:
                 return self.finish(True, done)
@@ -271,6 +280,7 @@ def follow_path(
     options: PathOptions,
     probe_names: Sequence[str],
     progress: Callable[[PathState], None] | None = None,
+    refine: RefineHook | None = None,
 ) -> PathResult:
     """Follow the equilibrium path of ``system`` from the unloaded state.
 
@@ -283,7 +293,12 @@ def follow_path(
     probe_names
         Probes recorded in every state (the until and driven probes are always added).
     progress
-        Called with every converged state (state 0 included), after ``system.commit``.
+        Called with every converged state (state 0 included), after ``system.commit``; a
+        state re-converged on a finer system comes again with its step number (the states
+        after it are dropped).
+    refine
+        Asked at every converged state whether the path goes on on a finer system
+        (:mod:`.switching`); None: never.
 
     Returns
     -------
@@ -291,4 +306,6 @@ def follow_path(
         All converged states (never NaN), whether a target was reached, a message saying where
         and why the path stopped, and the limit points / bifurcations found along it.
     """
-    return PathFollower(system, options, probe_names, progress).run()
+    follower = PathFollower(system, options, probe_names, progress)
+    follower.refine = refine
+    return follower.run()

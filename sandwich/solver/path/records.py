@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -11,7 +12,7 @@ from sandwich.solver.critical import Crossing
 from sandwich.solver.extrema import Extremum
 from sandwich.solver.system import Factorization
 
-__all__ = ["PathResult", "PathState", "Trial", "format_probes"]
+__all__ = ["PathResult", "PathState", "Refinement", "Trial", "format_probes"]
 
 
 @dataclass
@@ -60,6 +61,28 @@ class Trial:
     factorization: Factorization
     rises: int = 0  # the corrector's longest run of rises above its first residual
     increment_iterations: int | None = None  # until its increment test first passed
+
+
+@dataclass
+class Refinement:
+    """A finer discretisation of the same problem, continued from a converged state.
+
+    What a caller's ``refine`` hook hands :func:`~.follower.follow_path` to go on on another
+    system from the last converged state (:mod:`.switching`): the system, the map of a vector
+    of the old system's free DOFs onto the new one's, and the state re-converged on it with the
+    factorised tangent there.
+    """
+
+    system: object  # a DiscreteSystem
+    transfer: Callable[[np.ndarray], np.ndarray]
+    u: np.ndarray
+    load_factor: float
+    iterations: int
+    factorization: Factorization
+    # the refinement is of the state this many steps before the last: the steps after it are
+    # dropped and taken again on the new system (a critical point located within them is then
+    # located on that system)
+    rewind: int = 0
 
 
 def format_probes(probes: dict[str, float]) -> str:

@@ -34,6 +34,9 @@ class FollowerState:
         The probe vectors by name (the until and driven probes included) and the reference load.
     states
         The converged states so far (state 0 first).
+    switches
+        Where the path went on on a finer system (:mod:`.switching`): the index of the state
+        re-converged there and that state as it was before.
     admissible, state_columns
         The system's optional hooks (:class:`~sandwich.solver.system.OptionalHooks`), None
         where it lacks them.
@@ -85,6 +88,8 @@ class FollowerState:
         self.admissible = admissible if callable(admissible) else None
         columns = getattr(system, "state_columns", None)
         self.state_columns = columns if callable(columns) else None
+        # (index of a state re-converged on a finer system, that state as it was before)
+        self.switches: list[tuple[int, PathState]] = []
 
     # -- measures --------------------------------------------------------------------------------
     def probes(self, u: np.ndarray) -> dict[str, float]:
@@ -159,5 +164,12 @@ class FollowerState:
             message += (f" ({len(self.rescues)} step(s) taken under control of "
                         f"{self.opt.until_probe} where the arc collapsed at a critical point: "
                         f"step(s) {', '.join(map(str, self.rescues))})")
-        return PathResult(self.states, reached, message, find_limit_points(self.states),
-                          warnings)
+        return PathResult(self.states, reached, message, self._limit_points(), warnings)
+
+    def _limit_points(self) -> list:
+        """The critical points of each stretch of the path on one system (:mod:`.switching`)."""
+        found, start = [], 0
+        for index, old in self.switches:
+            found += find_limit_points([*self.states[start:index], old])
+            start = index
+        return found + find_limit_points(self.states[start:])
