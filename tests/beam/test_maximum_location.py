@@ -60,8 +60,9 @@ def test_the_top_a_probe_rescue_jumps_over_is_bounded_by_walking_its_branch():
     # fig. 6 with auto's reruns (AutoSettings(one_pass=False)): at λ 1952.4 the arc collapses
     # where the debonded face is about to snap, and the probe rescue steps to λ 1915.3 on the
     # branch beyond, both of its tangents rising. Reference: the same model (its core levels
-    # frozen) in displacement steps of at most 0.2 mm, stalling where that branch ends (the same end state in steps of 0.05 and
-    # 0.1 mm: λ 1976.79 at w_bottom −9.6470 mm, to 1e-11; the tangent stays regular up to it).
+    # frozen) in displacement steps of at most 0.2 mm, stalling where that branch ends (the
+    # same end state in steps of 0.05 and 0.1 mm: λ 1976.79 at w_bottom −9.6470 mm, to 1e-11;
+    # the tangent stays regular up to it).
     scene = load_scene(ROOT / "scenes" / "paper-fig6-top-debond-20-load-bottom.toml")
     shipped = solve_run(scene, auto=AutoSettings(one_pass=False))
     assert "under control of w_bottom_mid" in shipped.solution.message
