@@ -1,18 +1,23 @@
-"""``auto`` core levels in one pass: raised along the path where a raise changes the answer.
+"""``auto`` core levels in one pass: checked and raised along the path, never rerun.
 
 The path starts at the linear step's levels (:mod:`sandwich.beam.core_choice`). At a few of its
-converged states — half-way to the target (``CHECK_FRACTIONS``), right after a located critical
-point, and at the target — :class:`OnePass` (the path follower's ``refine`` hook,
-:mod:`sandwich.solver.path.switching`) continues the state into raised levels
-(:func:`~sandwich.beam.core_controller.raised_levels`: the state's residual shares and every
-debonded stretch and load patch) and re-converges it there by Newton at the same value of the
-until probe (the same load where the scene has no probe target).
-The change of the answer is the estimate (:func:`answer_change`: the load and every probe,
-relative to the largest): where ``BELOW_FACTOR ×`` it is within the tolerance, the path goes on
-at its levels with that estimate; else it goes on from the re-converged state at the raised
-levels, checked again at once. The core basis is hierarchical, so the old state is exactly a
-state of the raised model (:func:`~sandwich.beam.core_levels.transfer`). The path is followed
-once; the states before a raise stay at the levels they were computed with.
+converged states — a quarter, half and three quarters of the way to the target
+(``CHECK_FRACTIONS``), after a located critical point (the state before it) and at the target —
+:class:`OnePass`, the path follower's ``refine`` hook (:mod:`sandwich.solver.path.switching`),
+estimates the error of the answer there (:meth:`OnePass.estimate`): the state re-converged by
+Newton one core level higher everywhere, at the same value of the until probe (the same load
+where the scene has no probe target), and the change of the answer (:func:`answer_change`: the
+load and every probe), doubled for the levels above (``ESTIMATE_FACTOR``). The core basis
+is hierarchical, so the state is exactly a state of the higher model
+(:func:`~sandwich.beam.core_levels.transfer`).
+
+Within the tolerance, the path goes on. Beyond it, the levels are raised where the error lives
+(:func:`~sandwich.beam.core_controller.raised_levels`: every debonded stretch and load patch and
+the residual's share, up to ``max_core_level``), the state is re-converged there and checked
+again, and the path goes on at the raised levels from the last state a check kept (the steps
+after it are taken again), so every state keeps the accuracy its check found. A raised model
+with no equilibrium near the checked state, or with another inertia there, has left this path's
+branch: the raise goes back to an earlier state. The estimate at the target is the run's.
 """
 
 from __future__ import annotations
@@ -22,8 +27,8 @@ from collections.abc import Callable
 import numpy as np
 
 from sandwich.beam.build import build_model, scene_gauss_orders
+from sandwich.beam.core_basis import MAX_LEVEL
 from sandwich.beam.core_controller import (
-    BELOW_FACTOR,
     END_STATE_BACKTRACKS,
     END_STATE_ITERATIONS,
     raised_levels,
@@ -43,8 +48,18 @@ from sandwich.solver.system import inner_product
 CHECK_FRACTIONS = (0.25, 0.5, 0.75)
 #: Raises at one check at most (each one level on the raised elements).
 RAISES_PER_CHECK = 3
+#: The estimate is this many times the change δ one level higher everywhere: δ / (1 − ρ) for
+#: levels that converge at the rate ρ = ½ (the change to level 5 over δ, uniform levels on the
+#: nonlinear bend at 40 elements: 1.4, 2.2, 1.7 from levels 1, 2, 3).
+ESTIMATE_FACTOR = 2.0
 #: Earlier states a rewind at a critical point may go back to.
 REWIND_STATES = 3
+#: A raise goes back to the last state a check kept if that retakes at most this fraction of
+#: the steps so far (or REWIND_STATES).
+ANCHOR_REACH = 0.25
+#: Newton's tolerance of an estimate's state (the path's where tighter): its answer to ~1e-6,
+#: far below any tolerance a scene asks for.
+ESTIMATE_TOL = 1e-6
 #: A state is at its target within this relative distance (the follower's own test is tighter).
 AT_TARGET = 1e-4
 
@@ -67,10 +82,11 @@ class OnePass:
         self._fractions = list(CHECK_FRACTIONS)
         self._recent: list[PathState] = []  # the last states on the present model
         self._unreached: np.ndarray | None = None  # levels a check found no equilibrium at
+        # the last state checked within the tolerance, or raised: where a raise goes back to
+        self._anchor: PathState | None = None
         self._raises: dict[bytes, np.ndarray | None] = {}  # levels → the raise above them
         self._kept_step = -1  # the step of the last check that kept the levels
-        # the model and levels before the last raise
-        self._below: tuple[BeamModel, np.ndarray] | None = None
+        self._models: dict[bytes, BeamModel] = {}  # the higher models the checks use
         bm = scene.beam_model
         self.tolerance, self.top = float(bm.tolerance), int(bm.max_core_level)
 
@@ -83,7 +99,8 @@ class OnePass:
         model has no equilibrium near the checked state, or one whose tangent has another
         inertia (its critical point lies before), up to ``REWIND_STATES`` earlier states are
         tried (:meth:`_walk_back`): the raised model has left this path's branch, and the path
-        goes on at the raised levels from the latest state where it had not.
+        goes on at the raised levels from the latest state where it had not. Any raise goes
+        back to the last state a check kept or raised (:meth:`_back_to_anchor`).
         """
         recent = [s for s in self._recent if s.step < state.step and s.step > 0]
         self._recent = [*recent[-REWIND_STATES:], state]
@@ -107,20 +124,51 @@ class OnePass:
         elif found is not None and critical:
             checked, res = self._walk_back(start, earlier, found[0], checked, found[1])
             found = found[0], res
+        if found is not None:
+            checked, found = self._back_to_anchor(start, checked, found)
         self.checked_at_target = at_target and checked is state
         if found is None:
             self._kept_step = checked.step
+            self._anchor = checked
             return None
         levels, res = found
         self.choice.levels = levels
         self._recent = [PathState(checked.step, res.u, float(res.load_factor), 0,
                                   _probes(self.model, res.u), res.factorization.negative_pivots)]
+        self._anchor = self._recent[0]
+        self._kept_step = checked.step  # its raised state was checked in the raise loop
         if self.progress is not None:
             self.progress(PathNote(f"core levels raised at step {checked.step}: elements per "
                                    f"core level {level_counts(levels)}", restart=False))
         return Refinement(self.model, lambda v, old=start: transfer(v, old, self.model),
                           res.u, float(res.load_factor), res.iterations, res.factorization,
                           rewind=state.step - checked.step)
+
+    def _back_to_anchor(self, start: BeamModel, checked: PathState,
+                        found: tuple[np.ndarray, object]) -> tuple[PathState, tuple | None]:
+        """Go back to the last state checked within the tolerance (or raised), if it lifts.
+
+        The states after it were followed at levels whose error grew past the tolerance
+        before this check saw it; they are taken again at the raised levels, so that every
+        state of the path keeps the accuracy its check found — where that costs at most
+        ``ANCHOR_REACH`` of the steps so far (or ``REWIND_STATES``): a long path (fig. 7 c4, 34
+        steps at the check, 16 at the anchor) keeps those states at the levels they were
+        computed with, each within the raising check's estimate. ``found``: the raised levels and
+        the checked state raised; kept where the anchor does not lift with the same inertia.
+        """
+        anchor = self._anchor
+        if anchor is None or anchor.step >= checked.step or (
+                checked.step - anchor.step > max(REWIND_STATES, ANCHOR_REACH * checked.step)):
+            return checked, found
+        levels = found[0]
+        lifted = self.lift(start, anchor.u, anchor.load_factor, dict(anchor.probes), levels,
+                           self.model)
+        self.choice.passes.append(self._entry(anchor, levels, lifted, "back to the last check"))
+        if lifted is None or None in (anchor.negative_pivots,
+                                      lifted[1].factorization.negative_pivots) or (
+                anchor.negative_pivots != lifted[1].factorization.negative_pivots):
+            return checked, found
+        return anchor, (levels, lifted[1])
 
     def _walk_back(self, start: BeamModel, earlier: list[PathState], levels: np.ndarray,
                    checked: PathState, res: object | None) -> tuple[PathState, object | None]:
@@ -156,60 +204,124 @@ class OnePass:
         return checked, res
 
     def check(self, state: PathState) -> tuple[np.ndarray, object] | None:
-        """Raise while the change of ``state``'s answer asks for it; the raised state, or None.
+        """Estimate the error of ``state``'s answer; raise while it exceeds the tolerance.
 
-        Each raise re-converges the state at :func:`raised_levels` (:meth:`lift`); its change
-        δ (:func:`answer_change`) with ``BELOW_FACTOR × δ`` within the tolerance ends the
-        check at the levels below it, with that estimate, unless the raised state's tangent
-        has another inertia (the raised model has crossed a critical point this path has not:
-        fig. 6's wrinkling maximum, which level 1 does not have). Else the raised state is
-        kept, its own change the estimate until a later check. Where the levels cannot be raised any
-        further, the change from the levels below the last raise is the estimate
-        (:meth:`_change_from_below`). The choice's estimate is set; :attr:`model` is the
-        raised one.
+        The estimate (:meth:`estimate`): the state re-converged one level higher everywhere,
+        its answer's change δ doubled for the levels above. Within
+        the tolerance, and with the same inertia of the tangent there (else the higher model
+        has crossed a critical point this path has not: fig. 6's wrinkling maximum, which
+        level 1 does not have), the levels are kept. Else the state is re-converged at
+        :func:`raised_levels` (the zones and the residual's share, up to ``max_core_level``)
+        and checked again there. Returns the raised levels and state (None: none raised);
+        the choice's estimate is the last one made; :attr:`model` is the raised model.
         """
         levels = self.choice.levels.copy()
-        u, lam, probes = state.u, state.load_factor, dict(state.probes)
-        neg = state.negative_pivots
+        current = state
         raised = None
-        estimate: float | None = None
-        for _ in range(RAISES_PER_CHECK):
-            higher = self._raise_of(levels, PathState(state.step, u, lam, 0, probes, None))
+        self.choice.estimate = None
+        for _ in range(RAISES_PER_CHECK + 1):
+            found = self.estimate(current, levels)
+            if found is None:
+                break
+            estimate, crossed, look, up_state = found
+            self.choice.estimate = estimate
+            if estimate <= self.tolerance and not crossed:
+                break
+            higher = self._raise_of(levels, current)
             if higher is None:
                 self.capped = True
-                if raised is None:
-                    estimate = self._change_from_below(state.step, u, lam, probes)
                 break
-            lifted = self.lift(self.model, u, lam, probes, higher)
-            entry = {"stage": f"check at step {state.step}",
-                     "elements_per_level": level_counts(higher), "load_factor": lam,
-                     "reached": lifted is not None, "estimate": None}
-            self.choice.passes.append(entry)
-            if lifted is None:  # the raised model has no equilibrium near this one
-                self._unreached = higher
-                break
-            up, res = lifted
-            new_probes = _probes(up, res.u)
-            change = answer_change(lam, probes, float(res.load_factor), new_probes)
-            entry["load_factor"] = float(res.load_factor)
-            entry["estimate"] = change
-            crossed = None not in (neg, res.factorization.negative_pivots) and (
-                res.factorization.negative_pivots != neg)
-            entry["inertia_changed"] = crossed
-            if change is not None and BELOW_FACTOR * change <= self.tolerance and not crossed:
-                estimate = BELOW_FACTOR * change
-                entry["levels_below_kept"] = True
-                break
-            self._below = (self.model, levels)
-            self.model, levels, raised = up, higher, res
-            u, lam, probes = res.u, float(res.load_factor), new_probes
-            neg = res.factorization.negative_pivots
-            estimate = change  # the raise's own change, until a check of the raised levels
-            if not np.any(levels < self.top):
-                self.capped = True
-                break
-        self.choice.estimate = estimate
+            if np.array_equal(higher, look[0]):  # converged to the path's tolerance from there
+                up = look[1]
+                lifted = self.lift(up, up_state.u, float(up_state.load_factor),
+                                   _probes(up, up_state.u), higher, up)
+                if lifted is None:
+                    self._unreached = higher
+                    break
+                res = lifted[1]
+            else:
+                lifted = self.lift(self.model, current.u, current.load_factor,
+                                   dict(current.probes), higher)
+                self.choice.passes.append(self._entry(current, higher, lifted, "raise"))
+                if lifted is None:  # the raised model has no equilibrium near this one
+                    self._unreached = higher
+                    break
+                up, res = lifted
+            after = PathState(current.step, res.u, float(res.load_factor), 0,
+                              _probes(up, res.u), res.factorization.negative_pivots)
+            self.model, levels, raised, current = up, higher, res, after
         return None if raised is None else (levels, raised)
+
+    def estimate(self, state: PathState, levels: np.ndarray) -> tuple | None:
+        """The estimated error of ``state`` at ``levels``, and what it found, or None.
+
+        ``δ``: the change of the answer (:func:`answer_change`) with the state re-converged one
+        level higher everywhere (up to the hierarchy's top, beyond ``max_core_level``: what the
+        cap costs is measured too); the estimate ``ESTIMATE_FACTOR × δ``. Returns (estimate,
+        whether the higher state's tangent has another inertia, (higher levels, higher model),
+        higher state); None where nothing is higher or its Newton fails (then
+        :attr:`_unreached` is the levels a raise would go to).
+        """
+        look = np.minimum(levels + 1, MAX_LEVEL)
+        if np.array_equal(look, levels):
+            return None
+        up = self._model_at(look)
+        lifted = self.lift(self.model, state.u, state.load_factor, dict(state.probes), look, up,
+                           max(float(self.scene.analysis.tol), ESTIMATE_TOL))
+        entry = self._entry(state, look, lifted, "one level higher")
+        self.choice.passes.append(entry)
+        if lifted is None:
+            self._unreached = self._raise_of(levels, state)
+            self.choice.estimate = self._change_from_below(state, levels)
+            return None
+        _, res = lifted
+        change = answer_change(state.load_factor, state.probes, float(res.load_factor),
+                               _probes(up, res.u))
+        if change is None:
+            return None
+        estimate = ESTIMATE_FACTOR * change
+        crossed = None not in (state.negative_pivots, res.factorization.negative_pivots) and (
+            res.factorization.negative_pivots != state.negative_pivots)
+        entry.update(change=change, estimate=estimate, inertia_changed=crossed)
+        return estimate, crossed, (look, up), res
+
+    def _change_from_below(self, state: PathState, levels: np.ndarray) -> float | None:
+        """The change of the answer from one level lower (above 1): the estimate where the
+        state does not re-converge one level higher (a geometric series at the rate ½ puts the
+        error of ``levels`` at that change). None where all are at level 1 or it fails too.
+        """
+        below = np.maximum(levels - 1, 1)
+        if np.array_equal(below, levels):
+            return None
+        lifted = self.lift(self.model, state.u, state.load_factor, dict(state.probes), below,
+                           tol=max(float(self.scene.analysis.tol), ESTIMATE_TOL))
+        entry = self._entry(state, below, lifted, "one level lower")
+        self.choice.passes.append(entry)
+        if lifted is None:
+            return None
+        model, res = lifted
+        entry["change"] = entry["estimate"] = answer_change(
+            state.load_factor, state.probes, float(res.load_factor), _probes(model, res.u))
+        return entry["estimate"]
+
+    def _model_at(self, levels: np.ndarray) -> BeamModel:
+        """The model at ``levels`` (kept: the checks come back to the same higher levels)."""
+        key = levels.tobytes()
+        if key not in self._models:
+            self._models[key] = build_model(self.scene, elements=self.elements,
+                                            gauss=scene_gauss_orders(self.scene),
+                                            **{**self.options, "core_level": levels})
+        return self._models[key]
+
+    @staticmethod
+    def _entry(state: PathState, levels: np.ndarray, lifted: tuple | None, what: str) -> dict:
+        """The choice's passes entry of a state re-converged at ``levels``."""
+        entry = {"stage": f"check at step {state.step} ({what})",
+                 "elements_per_level": level_counts(levels), "load_factor": state.load_factor,
+                 "reached": lifted is not None, "estimate": None}
+        if lifted is not None:
+            entry["load_factor"] = float(lifted[1].load_factor)
+        return entry
 
     def _raise_of(self, levels: np.ndarray, state: PathState) -> np.ndarray | None:
         """The levels above ``levels`` (:func:`raised_levels` at the first state checked there).
@@ -224,42 +336,16 @@ class OnePass:
                                               self.model, state, levels, self.top)
         return self._raises[key]
 
-    def _change_from_below(self, step: int, u: np.ndarray, lam: float,
-                           probes: dict[str, float]) -> float | None:
-        """The change of the answer from the levels below the last raise to the present ones.
-
-        The state re-converged on the model before the last raise (:meth:`lift` downwards:
-        the enrichment amplitudes it lacks dropped); before any raise, on the levels one below
-        the present ones. None where all are at level 1, or where that Newton fails.
-        """
-        if self._below is None:  # no raise on this path: one level lower where above 1
-            levels = np.maximum(self.choice.levels - 1, 1)
-            if np.array_equal(levels, self.choice.levels):
-                return None
-            model = None
-        else:
-            model, levels = self._below
-        lifted = self.lift(self.model, u, lam, probes, levels, model)
-        entry = {"stage": f"check at step {step} (levels below)",
-                 "elements_per_level": level_counts(levels), "load_factor": lam,
-                 "reached": lifted is not None, "estimate": None}
-        self.choice.passes.append(entry)
-        if lifted is None:
-            return None
-        model, res = lifted
-        entry["load_factor"] = float(res.load_factor)
-        entry["estimate"] = answer_change(lam, probes, float(res.load_factor),
-                                          _probes(model, res.u))
-        return entry["estimate"]
-
     def lift(self, model: BeamModel, u: np.ndarray, lam: float, probes: dict[str, float],
-             levels: np.ndarray, up: BeamModel | None = None) -> tuple[BeamModel, object] | None:
+             levels: np.ndarray, up: BeamModel | None = None,
+             tol: float | None = None) -> tuple[BeamModel, object] | None:
         """The state ``(u, λ)`` of ``model`` re-converged on the model at ``levels``, or None.
 
         Newton with a backtracking line search from the carried-over state (new enrichment
         amplitudes zero), at the same value of the until probe where the scene has one, else at
         the same load. None where Newton fails or the state penetrates deeper than the model's
-        bound. ``up``: the model at ``levels`` if built already.
+        bound. ``up``: the model at ``levels`` if built already; ``tol``: Newton's (default the
+        scene's).
         """
         a = self.scene.analysis
         if up is None:
@@ -273,7 +359,7 @@ class OnePass:
             constraint = ProbeConstraint(np.asarray(up.probe_vector(name), dtype=float),
                                          float(probes[name]), inner_product(up))
         settings = NewtonSettings(
-            tol=float(a.tol), max_iterations=END_STATE_ITERATIONS,
+            tol=float(a.tol) if tol is None else tol, max_iterations=END_STATE_ITERATIONS,
             force_floor=float(np.linalg.norm(up.f_ref)) * abs(lam),
             backtracks=END_STATE_BACKTRACKS)
         res = newton_correct(up, transfer(u, model, up), lam, constraint, settings)
