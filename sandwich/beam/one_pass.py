@@ -286,9 +286,11 @@ class OnePass:
         return estimate, crossed, (look, up), res
 
     def _change_from_below(self, state: PathState, levels: np.ndarray) -> float | None:
-        """The change of the answer from one level lower (above 1): the estimate where the
-        state does not re-converge one level higher (a geometric series at the rate ½ puts the
-        error of ``levels`` at that change). None where all are at level 1 or it fails too.
+        """The change of the answer from one level lower (above 1), or None.
+
+        The estimate where the state does not re-converge one level higher: levels converging
+        at the rate ½ put the error of ``levels`` at that change. None where all are at level
+        1, or where it fails too.
         """
         below = np.maximum(levels - 1, 1)
         if np.array_equal(below, levels):
