@@ -34,6 +34,7 @@ from sandwich.beam.core_controller import (
     raised_levels,
 )
 from sandwich.beam.core_levels import LevelChoice, level_counts, transfer
+from sandwich.beam.fracture import release_columns
 from sandwich.beam.model import BeamModel
 from sandwich.beam.path_pass import max_penetration
 from sandwich.results import PathNote
@@ -54,6 +55,9 @@ RAISES_PER_CHECK = 3
 ESTIMATE_FACTOR = 2.0
 #: Earlier states a rewind at a critical point may go back to.
 REWIND_STATES = 3
+#: What the estimate of G at the debond tips (relative) and of its mode mix G_II/G (absolute)
+#: is held to: reported, and said where exceeded; the raises follow the load and probes.
+G_TOLERANCE = 0.03
 #: A raise goes back to the last state a check kept if that retakes at most this fraction of
 #: the steps so far (or REWIND_STATES).
 ANCHOR_REACH = 0.25
@@ -70,7 +74,9 @@ class OnePass:
     ``choice`` (the linear step's) is updated in place: its levels, estimate and passes are the
     answer's. :attr:`model` is the model the path is on; :attr:`capped` says a check wanted to
     raise where the debond and load zones are at ``max_core_level``; :attr:`checked_at_target`
-    that the last estimate was made at the target.
+    that the last estimate was made at the target; :attr:`quantities` holds its estimate per
+    quantity (the load and probes, which decide the raises; G and the mode mix G_II/G at the
+    debond tips, :func:`release_changes`, reported against ``G_TOLERANCE``).
     """
 
     def __init__(self, scene: object, elements: int | None, options: dict, choice: LevelChoice,
@@ -79,6 +85,8 @@ class OnePass:
         self.choice, self.model, self.progress = choice, model, progress
         self.capped = False
         self.checked_at_target = False
+        # the last estimate of each quantity: "load and probes", and "G", "G_II/G" at the tips
+        self.quantities: dict[str, float] = {}
         self._fractions = list(CHECK_FRACTIONS)
         self._recent: list[PathState] = []  # the last states on the present model
         self._unreached: np.ndarray | None = None  # levels a check found no equilibrium at
@@ -262,6 +270,7 @@ class OnePass:
         higher state); None where nothing is higher or its Newton fails (then
         :attr:`_unreached` is the levels a raise would go to).
         """
+        self.quantities = {}
         look = np.minimum(levels + 1, MAX_LEVEL)
         if np.array_equal(look, levels):
             return None
@@ -273,6 +282,8 @@ class OnePass:
         if lifted is None:
             self._unreached = self._raise_of(levels, state)
             self.choice.estimate = self._change_from_below(state, levels)
+            if self.choice.estimate is not None:
+                self.quantities = {"load and probes": self.choice.estimate}
             return None
         _, res = lifted
         change = answer_change(state.load_factor, state.probes, float(res.load_factor),
@@ -280,6 +291,13 @@ class OnePass:
         if change is None:
             return None
         estimate = ESTIMATE_FACTOR * change
+        self.quantities = {"load and probes": estimate}
+        if self.model.fracture_tips:
+            releases = release_changes(
+                release_columns(self.model, state.u, self.model.fracture_tips),
+                release_columns(up, res.u, up.fracture_tips))
+            self.quantities.update({k: ESTIMATE_FACTOR * v for k, v in releases.items()})
+        entry["quantities"] = dict(self.quantities)
         crossed = None not in (state.negative_pivots, res.factorization.negative_pivots) and (
             res.factorization.negative_pivots != state.negative_pivots)
         entry.update(change=change, estimate=estimate, inertia_changed=crossed)
@@ -424,6 +442,32 @@ def answer_change(load_factor: float, probes: dict[str, float], new_load_factor:
     if scale > 0.0 and common:
         changes.append(max(abs(new_probes[n] - probes[n]) for n in common) / scale)
     return max(changes) if changes else None
+
+
+def release_changes(before: dict[str, float | None],
+                    after: dict[str, float | None]) -> dict[str, float]:
+    """The change of G at the debond tips between two states' history columns.
+
+    ``"G"``: the largest change of a tip's total G relative to the largest G; ``"G_II/G"``: the
+    largest change of a tip's mode mix (absolute), over tips carrying at least 1e-6 of the
+    largest G. Empty where no tip has a G in both.
+    """
+    totals = [k for k in before if k.startswith("G_") and before[k] is not None
+              and after.get(k) is not None]
+    scale = max((abs(before[k]) for k in totals), default=0.0)
+    if scale <= 0.0:
+        return {}
+    out = {"G": max(abs(after[k] - before[k]) for k in totals) / scale}
+    mixes = []
+    for k in totals:
+        mode = "GII" + k[1:]
+        if min(abs(before[k]), abs(after[k])) < 1e-6 * scale or before.get(mode) is None \
+                or after.get(mode) is None:
+            continue
+        mixes.append(abs(after[mode] / after[k] - before[mode] / before[k]))
+    if mixes:
+        out["G_II/G"] = max(mixes)
+    return out
 
 
 def _probes(model: BeamModel, u: np.ndarray) -> dict[str, float]:

@@ -30,7 +30,7 @@ from sandwich.beam.core_levels import LevelChoice, level_counts
 from sandwich.beam.fracture import beam_tips, level_warning
 from sandwich.beam.linear_step import linear_solution, toward_target
 from sandwich.beam.model import BeamModel
-from sandwich.beam.one_pass import OnePass
+from sandwich.beam.one_pass import G_TOLERANCE, OnePass
 from sandwich.beam.path_pass import PathPass, follow_penalised
 from sandwich.beam.solution import beam_solution, growth_summary
 from sandwich.results import InterruptedSolve, Solution
@@ -86,6 +86,7 @@ def run(
     choice = choose_core_levels(scene, elements, options)
     nonlinear = a.kind == "nonlinear"
     limit_points = []
+    quantities: dict[str, float] = {}
     raised: list[float] = []
     warnings: list[str] = []
     capped = interrupted = False
@@ -96,7 +97,7 @@ def run(
         converged = True
     else:
         if choice.how == "auto" and (auto or AutoSettings()).one_pass:
-            path, capped = _one_pass(scene, elements, options, choice, progress)
+            path, capped, quantities = _one_pass(scene, elements, options, choice, progress)
         elif choice.how == "auto":
             controller = CoreController(scene, elements, options, choice, progress, auto)
             try:
@@ -132,6 +133,12 @@ def run(
                   if nonlinear and path_passes(choice) > 1 else "")
         warnings.append(f"the core's estimated error {said} (max_core_level "
                         f"{bm.max_core_level}{reruns})")
+    if quantities.get("G", 0.0) > G_TOLERANCE or quantities.get("G_II/G", 0.0) > G_TOLERANCE:
+        warnings.append(
+            "G at the debond tips: the core levels' estimated error "
+            f"{100 * quantities.get('G', 0.0):.2g} % (mode mix G_II/G: "
+            f"{quantities.get('G_II/G', 0.0):.2g}) exceeds {100 * G_TOLERANCE:.2g} % "
+            "(the element length's share is not estimated: docs/fracture.md)")
     if capped:
         message += (f"; the debond and load zones are at max_core_level {bm.max_core_level}: "
                     "what a further raise there would change is not measured")
@@ -149,6 +156,10 @@ def run(
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,
         "passes": choice.passes, "zones_at_max_level": capped,
         "tolerance": getattr(bm, "tolerance", None) if choice.how == "auto" else None,
+        "quantities": {name: {"estimated_error": value,
+                              "tolerance": G_TOLERANCE if name.startswith("G")
+                              else float(bm.tolerance)}
+                       for name, value in quantities.items()},
     }
     solution.wall_seconds = time.perf_counter() - t0
     if interrupted:
@@ -157,8 +168,11 @@ def run(
 
 
 def _one_pass(scene: Scene, elements: int | None, options: dict, choice: LevelChoice,
-              progress: Callable[[object], None] | None) -> tuple[PathPass, bool]:
-    """The path at ``auto`` levels checked and raised along it (:class:`OnePass`); capped.
+              progress: Callable[[object], None] | None) -> tuple[PathPass, bool, dict]:
+    """The path at ``auto`` levels checked and raised along it (:class:`OnePass`).
+
+    Returns the path, whether a check found the zones at ``max_core_level``, and the estimate
+    per quantity at the target (:attr:`OnePass.quantities`; empty where not made there).
 
     Each penalty rerun of the path starts again at the linear step's levels. Where the path
     stops short, the paper's element is the fallback (:func:`level_1_fallback`).
@@ -174,13 +188,15 @@ def _one_pass(scene: Scene, elements: int | None, options: dict, choice: LevelCh
     path = follow_penalised(scene, elements, {**options, "core_level": initial}, progress,
                             refine=hook)
     one = hooks[-1]
+    quantities = dict(one.quantities) if one.checked_at_target else {}
     if not one.checked_at_target:
         choice.estimate = None  # the last check was not at the path's end
     choice.passes.append({"stage": f"path step {path.last.step}",
                           "elements_per_level": level_counts(choice.levels),
                           "load_factor": path.last.load_factor, "reached": path.converged,
                           "estimate": choice.estimate})
-    return level_1_fallback(scene, elements, options, choice, path, progress), one.capped
+    path = level_1_fallback(scene, elements, options, choice, path, progress)
+    return path, one.capped, quantities if choice.estimate is not None else {}
 
 
 def _linear_states(model: BeamModel, scene: object) -> tuple[list[PathState], str]:
