@@ -240,3 +240,23 @@ def test_solve_says_how_accurate_the_run_claims_to_be(tmp_path, capsys):
         if core == '"auto"':
             est = json.loads((out / "summary.json").read_text())["core"]["estimated_error"]
             assert f"{100 * est:.2g} %" in printed
+
+
+def test_solve_names_each_estimated_quantity(tmp_path, capsys):
+    """A nonlinear auto run on a debonded scene: the load and probes' estimate and G's, each
+    against its tolerance, as summary.json has them."""
+    from sandwich.cli import main as cli_main
+
+    scene = ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml"
+    text = scene.read_text().replace("value = -15", "value = -3")
+    assert "value = -3" in text
+    path = tmp_path / "s.toml"
+    path.write_text(text + "\n[beam_model]\nelements = 60\n")
+    assert cli_main(["solve", str(path), "--model", "beam", "--out", str(tmp_path / "r")]) == 0
+    printed = capsys.readouterr().out
+    quantities = json.loads((tmp_path / "r" / "summary.json").read_text())["core"]["quantities"]
+    assert {"load and probes", "G"} <= set(quantities)
+    for name, q in quantities.items():
+        e, t = q["estimated_error"], q["tolerance"]
+        assert (f"{name} {100 * e:.2g} % ({'within' if e <= t else 'above'} {100 * t:.2g} %)"
+                in printed), printed

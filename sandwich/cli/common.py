@@ -82,7 +82,7 @@ def overridden(scene: Scene, model: str, args: argparse.Namespace) -> Scene:
 
 
 def accuracy_line(model: str, sol: Solution) -> str:
-    """What a run says of its own accuracy: the beam's estimate of its core levels, or none."""
+    """What a run says of its own accuracy: the beam's estimates per quantity, or none."""
     core = sol.extra.get("core")
     if not isinstance(core, dict) or core.get("how") != "auto":
         return (f"{model}: no error estimate at a fixed resolution (compare with another "
@@ -90,10 +90,19 @@ def accuracy_line(model: str, sol: Solution) -> str:
     est, tol = core.get("estimated_error"), core.get("tolerance")
     if est is None:
         return f"{model}: the core levels' error could not be estimated (see the warnings)"
-    met = "within" if tol is not None and est <= tol else "above"
-    return (f"{model}: estimated error of the core levels {100 * est:.2g} % ({met} the "
-            f"tolerance {100 * tol:.2g} %)" if tol is not None else
-            f"{model}: estimated error of the core levels {100 * est:.2g} %")
+    quantities = core.get("quantities") or {}
+    if not quantities:
+        quantities = {"load and probes": {"estimated_error": est, "tolerance": tol}}
+    parts = []
+    for name, q in quantities.items():
+        e, t = q.get("estimated_error"), q.get("tolerance")
+        if e is None:
+            continue
+        said = f"{name} {100 * e:.2g} %"
+        if t is not None:
+            said += f" ({'within' if e <= t else 'above'} {100 * t:.2g} %)"
+        parts.append(said)
+    return f"{model}: estimated error of the core levels: " + ", ".join(parts)
 
 
 def overridden_both(scene: Scene, args: argparse.Namespace) -> Scene:
