@@ -28,11 +28,7 @@ import numpy as np
 
 from sandwich.beam.build import build_model, scene_gauss_orders
 from sandwich.beam.core_basis import MAX_LEVEL
-from sandwich.beam.core_controller import (
-    END_STATE_BACKTRACKS,
-    END_STATE_ITERATIONS,
-    raised_levels,
-)
+from sandwich.beam.core_controller import raised_levels
 from sandwich.beam.core_levels import LevelChoice, level_counts, transfer
 from sandwich.beam.fracture import release_columns
 from sandwich.beam.model import BeamModel
@@ -61,6 +57,11 @@ G_TOLERANCE = 0.03
 #: A raise goes back to the last state a check kept if that retakes at most this fraction of
 #: the steps so far (or REWIND_STATES).
 ANCHOR_REACH = 0.25
+#: Newton's iterations and backtracking halvings of a state re-converged at other levels: a
+#: state carried over converged in 2-10 on fig. 5, fig. 6 and the demo scene, 15 once on c1;
+#: one that takes more has left the levels' equilibrium, and failing early keeps that cheap.
+LIFT_ITERATIONS = 20
+LIFT_BACKTRACKS = 8
 #: Newton's tolerance of an estimate's state (the path's where tighter): its answer to ~1e-6,
 #: far below any tolerance a scene asks for.
 ESTIMATE_TOL = 1e-6
@@ -341,6 +342,7 @@ class OnePass:
                  "reached": lifted is not None, "estimate": None}
         if lifted is not None:
             entry["load_factor"] = float(lifted[1].load_factor)
+            entry["iterations"] = int(lifted[1].iterations)
         return entry
 
     def _raise_of(self, levels: np.ndarray, state: PathState) -> np.ndarray | None:
@@ -379,9 +381,8 @@ class OnePass:
             constraint = ProbeConstraint(np.asarray(up.probe_vector(name), dtype=float),
                                          float(probes[name]), inner_product(up))
         settings = NewtonSettings(
-            tol=float(a.tol) if tol is None else tol, max_iterations=END_STATE_ITERATIONS,
-            force_floor=float(np.linalg.norm(up.f_ref)) * abs(lam),
-            backtracks=END_STATE_BACKTRACKS)
+            tol=float(a.tol) if tol is None else tol, max_iterations=LIFT_ITERATIONS,
+            force_floor=float(np.linalg.norm(up.f_ref)) * abs(lam), backtracks=LIFT_BACKTRACKS)
         res = newton_correct(up, transfer(u, model, up), lam, constraint, settings)
         if not res.converged or res.load_factor == 0.0 or res.factorization is None:
             return None
