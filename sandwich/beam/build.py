@@ -107,6 +107,7 @@ def build_model(
     core_level: int | np.ndarray | None = None,
     core_basis: str = "sublayers",
     face_stretch: bool | None = None,
+    mesh: BeamMesh | None = None,
 ) -> BeamModel:
     """Discretise ``scene`` (a :class:`sandwich.scene.Scene`) with the beam element.
 
@@ -160,6 +161,10 @@ def build_model(
         (:func:`~sandwich.beam.layer_operators.build_face_operators`), so that a rotated face
         bends as stiffly as an unrotated one; stored first in each node's extra block.
         Default: the scene's ``[beam_model] faces`` (``"stretch"`` unless it says ``"paper"``).
+    mesh
+        The nodes along x, in place of the ones ``elements`` and ``grading`` give (every
+        station must be a node: :func:`sandwich.beam.bisection.bisected_mesh` of a built
+        model's mesh keeps them).
     """
     options = getattr(scene, "beam_model", None)
     if face_membrane is None:
@@ -172,7 +177,8 @@ def build_model(
         face_stretch = getattr(options, "faces", BeamModelOptions.faces) == "stretch"
     if elements is None:
         elements = getattr(options, "elements", BeamModelOptions.elements)
-    mesh = beam_mesh(scene, elements, grading=grading, growth=growth, size_ratio=size_ratio)
+    if mesh is None:
+        mesh = beam_mesh(scene, elements, grading=grading, growth=growth, size_ratio=size_ratio)
     if not (np.isfinite(scene.width) and scene.width > 0):
         raise ValueError(f"beam width must be positive, got {scene.width!r}")
     orders = dict(EXACT_ORDER)

@@ -26,6 +26,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from sandwich.beam.bisection import bisected_levels, bisected_mesh, bisected_state
 from sandwich.beam.build import build_model, scene_gauss_orders
 from sandwich.beam.core_basis import MAX_LEVEL
 from sandwich.beam.core_controller import raised_levels
@@ -62,6 +63,9 @@ ANCHOR_REACH = 0.25
 #: one that takes more has left the levels' equilibrium, and failing early keeps that cheap.
 LIFT_ITERATIONS = 20
 LIFT_BACKTRACKS = 8
+#: ... and of the state carried onto the bisected mesh (a start, not the same field: 10-20
+#: iterations on fig. 5, the demo scene and fig. 9 d10).
+LENGTH_ITERATIONS = 30
 #: Newton's tolerance of an estimate's state (the path's where tighter): its answer to ~1e-6,
 #: far below any tolerance a scene asks for.
 ESTIMATE_TOL = 1e-6
@@ -77,7 +81,8 @@ class OnePass:
     raise where the debond and load zones are at ``max_core_level``; :attr:`checked_at_target`
     that the last estimate was made at the target; :attr:`quantities` holds its estimate per
     quantity (the load and probes, which decide the raises; G and the mode mix G_II/G at the
-    debond tips, :func:`release_changes`, reported against ``G_TOLERANCE``).
+    debond tips, :func:`release_changes`, reported against ``G_TOLERANCE``), :attr:`lengths`
+    the element length's share of each at the target (:meth:`length_estimate`).
     """
 
     def __init__(self, scene: object, elements: int | None, options: dict, choice: LevelChoice,
@@ -88,6 +93,8 @@ class OnePass:
         self.checked_at_target = False
         # the last estimate of each quantity: "load and probes", and "G", "G_II/G" at the tips
         self.quantities: dict[str, float] = {}
+        # at the target: the element length's share of each (None: not measured)
+        self.lengths: dict[str, float] | None = None
         self._fractions = list(CHECK_FRACTIONS)
         self._recent: list[PathState] = []  # the last states on the present model
         self._unreached: np.ndarray | None = None  # levels a check found no equilibrium at
@@ -139,12 +146,16 @@ class OnePass:
         if found is None:
             self._kept_step = checked.step
             self._anchor = checked
+            if self.checked_at_target and self.choice.estimate is not None:
+                self.lengths = self.length_estimate(state)
             return None
         levels, res = found
         self.choice.levels = levels
         self._recent = [PathState(checked.step, res.u, float(res.load_factor), 0,
                                   _probes(self.model, res.u), res.factorization.negative_pivots)]
         self._anchor = self._recent[0]
+        if self.checked_at_target and self.choice.estimate is not None:
+            self.lengths = self.length_estimate(self._recent[0])
         self._kept_step = checked.step  # its raised state was checked in the raise loop
         if self.progress is not None:
             self.progress(PathNote(f"core levels raised at step {checked.step}: elements per "
@@ -364,16 +375,25 @@ class OnePass:
         """The state ``(u, λ)`` of ``model`` re-converged on the model at ``levels``, or None.
 
         Newton with a backtracking line search from the carried-over state (new enrichment
-        amplitudes zero), at the same value of the until probe where the scene has one, else at
-        the same load. None where Newton fails or the state penetrates deeper than the model's
-        bound. ``up``: the model at ``levels`` if built already; ``tol``: Newton's (default the
-        scene's).
+        amplitudes zero): :meth:`reconverge`. ``up``: the model at ``levels`` if built already;
+        ``tol``: Newton's (default the scene's).
         """
-        a = self.scene.analysis
         if up is None:
             up = build_model(self.scene, elements=self.elements,
                              gauss=scene_gauss_orders(self.scene),
                              **{**self.options, "core_level": levels})
+        return self.reconverge(up, transfer(u, model, up), lam, probes, tol, LIFT_BACKTRACKS)
+
+    def reconverge(self, up: BeamModel, start: np.ndarray, lam: float, probes: dict[str, float],
+                   tol: float | None, backtracks: int,
+                   iterations: int = 0) -> tuple[BeamModel, object] | None:
+        """Newton on ``up`` from ``start`` to the state at the same until probe (else load).
+
+        At the same value of the until probe where the scene has one, else at the same load;
+        ``backtracks`` halvings of a correction that does not lower the residual, at most
+        ``iterations`` (default ``LIFT_ITERATIONS``). None where Newton fails or the state
+        penetrates deeper than the model's bound.
+        """
         name = self._held_probe(probes)
         if name is None:
             constraint = LoadConstraint(lam)
@@ -381,14 +401,59 @@ class OnePass:
             constraint = ProbeConstraint(np.asarray(up.probe_vector(name), dtype=float),
                                          float(probes[name]), inner_product(up))
         settings = NewtonSettings(
-            tol=float(a.tol) if tol is None else tol, max_iterations=LIFT_ITERATIONS,
-            force_floor=float(np.linalg.norm(up.f_ref)) * abs(lam), backtracks=LIFT_BACKTRACKS)
-        res = newton_correct(up, transfer(u, model, up), lam, constraint, settings)
+            tol=float(self.scene.analysis.tol) if tol is None else tol,
+            max_iterations=iterations or LIFT_ITERATIONS,
+            force_floor=float(np.linalg.norm(up.f_ref)) * abs(lam), backtracks=backtracks)
+        res = newton_correct(up, start, lam, constraint, settings)
         if not res.converged or res.load_factor == 0.0 or res.factorization is None:
             return None
         if max_penetration(up, [res.u]) > up.penetration_bound():
             return None
         return up, res
+
+    def length_estimate(self, state: PathState) -> dict[str, float] | None:
+        """The element length's share of the error of ``state`` (on :attr:`model`), or None.
+
+        The state re-converged on the mesh with every element split in two, at the same core
+        levels (:mod:`sandwich.beam.bisection`; Newton with the line search, then plain where
+        that stalls: the carried-over state is a start, not the same field, and its residual
+        is large);
+        ``ESTIMATE_FACTOR`` × each quantity's
+        change (the load and probes, G and G_II/G at the tips). None where Newton fails.
+        """
+        fine = build_model(self.scene, gauss=scene_gauss_orders(self.scene),
+                           **{**self.options,
+                              "core_level": bisected_levels(self.choice.levels)},
+                           mesh=bisected_mesh(self.model.mesh))
+        start = bisected_state(state.u, self.model, fine)
+        tol = max(float(self.scene.analysis.tol), ESTIMATE_TOL)
+        found = None
+        for backtracks in (LIFT_BACKTRACKS, 0):
+            found = self.reconverge(fine, start, state.load_factor, dict(state.probes), tol,
+                                    backtracks, LENGTH_ITERATIONS)
+            if found is not None:
+                break
+        entry = {"stage": f"check at step {state.step} (elements split in two)",
+                 "elements_per_level": level_counts(bisected_levels(self.choice.levels)),
+                 "load_factor": state.load_factor, "reached": found is not None,
+                 "estimate": None}
+        self.choice.passes.append(entry)
+        if found is None:
+            return None
+        _, res = found
+        change = answer_change(state.load_factor, state.probes, float(res.load_factor),
+                               _probes(fine, res.u))
+        if change is None:
+            return None
+        out = {"load and probes": ESTIMATE_FACTOR * change}
+        if self.model.fracture_tips:
+            releases = release_changes(
+                release_columns(self.model, state.u, self.model.fracture_tips),
+                release_columns(fine, res.u, fine.fracture_tips))
+            out.update({k: ESTIMATE_FACTOR * v for k, v in releases.items()})
+        entry.update(load_factor=float(res.load_factor), iterations=int(res.iterations),
+                     change=change, estimate=out["load and probes"], quantities=dict(out))
+        return out
 
     def _held_probe(self, probes: dict[str, float]) -> str | None:
         """The probe a lift holds: the until probe (None without one, or at 0: the load)."""

@@ -86,7 +86,7 @@ def run(
     choice = choose_core_levels(scene, elements, options)
     nonlinear = a.kind == "nonlinear"
     limit_points = []
-    quantities: dict[str, float] = {}
+    quantities: dict[str, dict] = {}
     raised: list[float] = []
     warnings: list[str] = []
     capped = interrupted = False
@@ -133,12 +133,7 @@ def run(
                   if nonlinear and path_passes(choice) > 1 else "")
         warnings.append(f"the core's estimated error {said} (max_core_level "
                         f"{bm.max_core_level}{reruns})")
-    above = [f"{name} {100 * value:.2g} %" for name, value in quantities.items()
-             if name.startswith("G") and value > G_TOLERANCE]
-    if above:
-        warnings.append(f"G at the debond tips: the core levels' estimated error of "
-                        f"{' and '.join(above)} exceeds {100 * G_TOLERANCE:.2g} % (the element "
-                        "length's share is not estimated: docs/fracture.md)")
+    warnings += quantity_warnings(quantities, float(bm.tolerance))
     if capped:
         message += (f"; the debond and load zones are at max_core_level {bm.max_core_level}: "
                     "what a further raise there would change is not measured")
@@ -156,10 +151,9 @@ def run(
         "levels": choice.zones(model.mesh), "estimated_error": choice.estimate,
         "passes": choice.passes, "zones_at_max_level": capped,
         "tolerance": getattr(bm, "tolerance", None) if choice.how == "auto" else None,
-        "quantities": {name: {"estimated_error": value,
-                              "tolerance": G_TOLERANCE if name.startswith("G")
-                              else float(bm.tolerance)}
-                       for name, value in quantities.items()},
+        "quantities": {name: {**parts, "estimated_error": _total(parts),
+                              "tolerance": _tolerance(name, float(bm.tolerance))}
+                       for name, parts in quantities.items()},
     }
     solution.wall_seconds = time.perf_counter() - t0
     if interrupted:
@@ -171,8 +165,10 @@ def _one_pass(scene: Scene, elements: int | None, options: dict, choice: LevelCh
               progress: Callable[[object], None] | None) -> tuple[PathPass, bool, dict]:
     """The path at ``auto`` levels checked and raised along it (:class:`OnePass`).
 
-    Returns the path, whether a check found the zones at ``max_core_level``, and the estimate
-    per quantity at the target (:attr:`OnePass.quantities`; empty where not made there).
+    Returns the path, whether a check found the zones at ``max_core_level``, and per quantity
+    at the target its estimate's shares: ``core_levels`` (:attr:`OnePass.quantities`) and
+    ``element_length`` (:attr:`OnePass.lengths`, None where not measured); empty where no
+    estimate was made there.
 
     Each penalty rerun of the path starts again at the linear step's levels. Where the path
     stops short, the paper's element is the fallback (:func:`level_1_fallback`).
@@ -188,7 +184,11 @@ def _one_pass(scene: Scene, elements: int | None, options: dict, choice: LevelCh
     path = follow_penalised(scene, elements, {**options, "core_level": initial}, progress,
                             refine=hook)
     one = hooks[-1]
-    quantities = dict(one.quantities) if one.checked_at_target else {}
+    quantities = {}
+    if one.checked_at_target:
+        lengths = one.lengths or {}
+        quantities = {name: {"core_levels": value, "element_length": lengths.get(name)}
+                      for name, value in one.quantities.items()}
     if not one.checked_at_target:
         choice.estimate = None  # the last check was not at the path's end
     choice.passes.append({"stage": f"path step {path.last.step}",
@@ -197,6 +197,43 @@ def _one_pass(scene: Scene, elements: int | None, options: dict, choice: LevelCh
                           "estimate": choice.estimate})
     path = level_1_fallback(scene, elements, options, choice, path, progress)
     return path, one.capped, quantities if choice.estimate is not None else {}
+
+
+def _total(parts: dict[str, float | None]) -> float | None:
+    """A quantity's estimate: its core levels' and element length's shares (None: one missing)."""
+    values = list(parts.values())
+    return None if any(v is None for v in values) else float(sum(values))
+
+
+def _tolerance(name: str, tolerance: float) -> float:
+    """What a quantity is held to: G and G_II/G ``G_TOLERANCE``, the rest the scene's."""
+    return G_TOLERANCE if name.startswith("G") else tolerance
+
+
+def quantity_warnings(quantities: dict[str, dict], tolerance: float) -> list[str]:
+    """What a run must say of its quantities' estimates at the target.
+
+    The element length's share where not measured, or where a quantity's estimate (core levels
+    plus element length) exceeds its tolerance — the core levels' part of the load and probes
+    alone is said by the caller (``the core's estimated error …``).
+    """
+    out = []
+    if quantities and all(q["element_length"] is None for q in quantities.values()):
+        out.append("the element length's share of the error is not measured (the state did "
+                   "not re-converge with every element split in two)")
+        return out
+    for name, parts in quantities.items():
+        total, tol = _total(parts), _tolerance(name, tolerance)
+        if total is None or total <= tol:
+            continue
+        if name == "load and probes" and parts["core_levels"] > tol:
+            continue  # said with the core levels' estimate
+        out.append(f"{name}: estimated error {100 * total:.2g} % (core levels "
+                   f"{100 * parts['core_levels']:.2g} %, element length "
+                   f"{100 * parts['element_length']:.2g} %) exceeds {100 * tol:.2g} %"
+                   + ("; more elements ([beam_model] elements) would lower it"
+                      if parts["element_length"] > parts["core_levels"] else ""))
+    return out
 
 
 def _linear_states(model: BeamModel, scene: object) -> tuple[list[PathState], str]:

@@ -97,6 +97,9 @@ def accuracy_line(model: str, sol: Solution) -> str:
     for name, q in quantities.items():
         e, t = q.get("estimated_error"), q.get("tolerance")
         if e is None:
+            if q.get("core_levels") is not None:
+                parts.append(f"{name} ≥ {100 * q['core_levels']:.2g} % (core levels; element "
+                             "length not measured)")
             continue
         said = f"{name} {100 * e:.2g} %"
         if t is not None:
