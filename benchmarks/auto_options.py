@@ -74,7 +74,8 @@ def measure(case: str, variant: str, repeat: int, ref: float) -> dict:
     for e in r.model.element_levels:
         counts[int(e)] = counts.get(int(e), 0) + 1
     lam = s.history[-1].load_factor
-    est = core["estimated_error"]
+    total = (core.get("quantities") or {}).get("load and probes")
+    est = core["estimated_error"] if total is None else total["estimated_error"]
     return dict(case=case, variant=variant, seconds=f"{seconds:.3f}",
                 error=f"{100 * (lam / ref - 1):+.3f} %",
                 estimate="" if est is None else f"{100 * est:.2f} %",
@@ -95,7 +96,8 @@ def write(rows: list[dict], refs: dict[str, tuple[float, str]], out: Path, stamp
     lines = ["# What `core = \"auto\"` costs, and what it could (benchmarks/auto_options.py)", "",
              "Each variant is a scene setting a user can write (module docstring). Seconds: solve",
              "in one process after an untimed run, best of the repeats; error: end load against",
-             "the 2D reference; `estimate`: what the run reports about itself (`estimate_from`:",
+             "the 2D reference; `estimate`: what the run reports about its end load (with the",
+             "element length's share where measured; `estimate_from`:",
              "a check on a nonlinear state, or the linear step only — which does not see the",
              "buckled debond); checks: the states re-converged at other levels. Machine: "
              + os.uname().machine + f", {os.cpu_count()} cores; "
