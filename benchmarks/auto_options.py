@@ -23,14 +23,13 @@ a setting's cost), best of ``--repeat``. Error: end load against the 2D referenc
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
 import os
 import time
 from pathlib import Path
 
 from benchmarks.core_levels import case_scene, reference
-from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from benchmarks.provenance import RESULTS, add_out_argument, measured_on, write_rows
 from sandwich.beam import run
 from sandwich.beam.core_controller import AutoSettings
 
@@ -88,11 +87,7 @@ def measure(case: str, variant: str, repeat: int, ref: float) -> dict:
 
 
 def write(rows: list[dict], refs: dict[str, tuple[float, str]], out: Path, stamp: str) -> None:
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "auto_options.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, FIELDS)
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "auto_options.csv", FIELDS, rows)
     lines = ["# What `core = \"auto\"` costs, and what it could (benchmarks/auto_options.py)", "",
              "Each variant is a scene setting a user can write (module docstring). Seconds: solve",
              "in one process after an untimed run, best of the repeats; error: end load against",

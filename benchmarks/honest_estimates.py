@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 
 from benchmarks.core_levels import case_scene, reference
-from benchmarks.provenance import RESULTS, add_out_argument, measured_on
+from benchmarks.provenance import RESULTS, add_out_argument, measured_on, write_rows
 from sandwich.beam import run
 from sandwich.scene_file import load_scene
 
@@ -163,11 +163,7 @@ def _parts(parts: dict) -> str:
 
 
 def write(rows: list[dict], out: Path, stamp: str) -> None:
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "honest_estimates.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, FIELDS)
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "honest_estimates.csv", FIELDS, rows)
     lines = ["# Does auto's estimate cover its true error? (benchmarks/honest_estimates.py)", "",
              stamp, "",
              "The beam at each scene's defaults (`core = \"auto\"`, one pass, tolerance 1 %; G",

@@ -61,6 +61,15 @@ def machine_and_date(sentence: str) -> str:
     return sentence.removeprefix("Measured on ").removesuffix(".")
 
 
+def write_rows(path: Path, fields: list[str], rows: list[dict]) -> None:
+    """Write ``rows`` as the csv at ``path`` (its folder made), header ``fields``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fields)
+        w.writeheader()
+        w.writerows(rows)
+
+
 def append_row(path: Path, fields: list[str], row: dict) -> None:
     """Append ``row`` to the csv at ``path``, rewriting its header to ``fields`` if it differs."""
     if path.exists():

@@ -298,17 +298,11 @@ class OnePass:
                 self.quantities = {"load and probes": self.choice.estimate}
             return None
         _, res = lifted
-        change = answer_change(state.load_factor, state.probes, float(res.load_factor),
-                               _probes(up, res.u))
-        if change is None:
+        found = self._estimates(state, up, res)
+        if found is None:
             return None
-        estimate = ESTIMATE_FACTOR * change
-        self.quantities = {"load and probes": estimate}
-        if self.model.fracture_tips:
-            releases = release_changes(
-                release_columns(self.model, state.u, self.model.fracture_tips),
-                release_columns(up, res.u, up.fracture_tips))
-            self.quantities.update({k: ESTIMATE_FACTOR * v for k, v in releases.items()})
+        change, self.quantities = found
+        estimate = self.quantities["load and probes"]
         entry["quantities"] = dict(self.quantities)
         crossed = None not in (state.negative_pivots, res.factorization.negative_pivots) and (
             res.factorization.negative_pivots != state.negative_pivots)
@@ -441,19 +435,33 @@ class OnePass:
         if found is None:
             return None
         _, res = found
+        estimated = self._estimates(state, fine, res)
+        if estimated is None:
+            return None
+        change, out = estimated
+        entry.update(load_factor=float(res.load_factor), iterations=int(res.iterations),
+                     change=change, estimate=out["load and probes"], quantities=dict(out))
+        return out
+
+    def _estimates(self, state: PathState, other: BeamModel,
+                   res: object) -> tuple[float, dict[str, float]] | None:
+        """``state`` against its re-converged ``res`` on ``other``: (δ, estimate per quantity).
+
+        δ the change of the load and probes (:func:`answer_change`), and ``ESTIMATE_FACTOR`` ×
+        each quantity's change (with G and G_II/G at the tips, :func:`release_changes`). None
+        where nothing can be compared.
+        """
         change = answer_change(state.load_factor, state.probes, float(res.load_factor),
-                               _probes(fine, res.u))
+                               _probes(other, res.u))
         if change is None:
             return None
         out = {"load and probes": ESTIMATE_FACTOR * change}
         if self.model.fracture_tips:
             releases = release_changes(
                 release_columns(self.model, state.u, self.model.fracture_tips),
-                release_columns(fine, res.u, fine.fracture_tips))
+                release_columns(other, res.u, other.fracture_tips))
             out.update({k: ESTIMATE_FACTOR * v for k, v in releases.items()})
-        entry.update(load_factor=float(res.load_factor), iterations=int(res.iterations),
-                     change=change, estimate=out["load and probes"], quantities=dict(out))
-        return out
+        return change, out
 
     def _held_probe(self, probes: dict[str, float]) -> str | None:
         """The probe a lift holds: the until probe (None without one, or at 0: the load)."""
