@@ -153,7 +153,10 @@ def test_shipped_scene_reaches_its_until_with_auto_levels(path):
     sol = r.solution
     assert sol.converged, sol.message
     assert sol.extra["core"]["how"] == "auto"
-    assert np.isfinite(sol.extra["core"]["estimated_error"])
+    est = sol.extra["core"]["estimated_error"]
+    # measured, or said not to be (never a silent gap)
+    assert (est is not None and np.isfinite(est)) or any(
+        "could not be estimated" in w for w in sol.warnings), sol.warnings
     assert sol.extra["max_penetration"] <= r.model.penetration_bound()
 
 
