@@ -91,8 +91,10 @@ def accuracy_line(model: str, sol: Solution) -> str:
     if est is None:
         return f"{model}: the core levels' error could not be estimated (see the warnings)"
     quantities = core.get("quantities") or {}
+    what = "estimated error at the target (core levels and element length)"
     if not quantities:
         quantities = {"load and probes": {"estimated_error": est, "tolerance": tol}}
+        what = "estimated error of the core levels"
     parts = []
     for name, q in quantities.items():
         e, t = q.get("estimated_error"), q.get("tolerance")
@@ -105,7 +107,7 @@ def accuracy_line(model: str, sol: Solution) -> str:
         if t is not None:
             said += f" ({'within' if e <= t else 'above'} {100 * t:.2g} %)"
         parts.append(said)
-    return f"{model}: estimated error of the core levels: " + ", ".join(parts)
+    return f"{model}: {what}: " + ", ".join(parts)
 
 
 def overridden_both(scene: Scene, args: argparse.Namespace) -> Scene:
