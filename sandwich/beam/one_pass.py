@@ -63,9 +63,10 @@ ANCHOR_REACH = 0.25
 #: one that takes more has left the levels' equilibrium, and failing early keeps that cheap.
 LIFT_ITERATIONS = 20
 LIFT_BACKTRACKS = 8
-#: ... and of the state carried onto the bisected mesh (a start, not the same field: 10-20
-#: iterations on fig. 5, the demo scene and fig. 9 d10).
-LENGTH_ITERATIONS = 30
+#: ... and of the state carried onto the bisected mesh (a start, not the same field): plain
+#: Newton first (demo 13 iterations, d10 20; fig. 5 and fig. 6 fail it, 2.3 s), then with the
+#: line search (fig. 5 17, fig. 6 20; it fails the demo and d10 after 4-5 s).
+LENGTH_ITERATIONS = (22, 24)
 #: Newton's tolerance of an estimate's state (the path's where tighter): its answer to ~1e-6,
 #: far below any tolerance a scene asks for.
 ESTIMATE_TOL = 1e-6
@@ -409,9 +410,9 @@ class OnePass:
         """The element length's share of the error of ``state`` (on :attr:`model`), or None.
 
         The state re-converged on the mesh with every element split in two, at the same core
-        levels (:mod:`sandwich.beam.bisection`; Newton with the line search, then plain where
-        that stalls: the carried-over state is a start, not the same field, and its residual
-        is large);
+        levels (:mod:`sandwich.beam.bisection`; plain Newton, then with the line search where
+        that fails: the carried-over state is a start, not the same field, and its residual is
+        large);
         ``ESTIMATE_FACTOR`` × each quantity's
         change (the load and probes, G and G_II/G at the tips). None where Newton fails.
         """
@@ -422,9 +423,10 @@ class OnePass:
         start = bisected_state(state.u, self.model, fine)
         tol = max(float(self.scene.analysis.tol), ESTIMATE_TOL)
         found = None
-        for backtracks in (LIFT_BACKTRACKS, 0):
+        for backtracks, iterations in ((0, LENGTH_ITERATIONS[0]),
+                                       (LIFT_BACKTRACKS, LENGTH_ITERATIONS[1])):
             found = self.reconverge(fine, start, state.load_factor, dict(state.probes), tol,
-                                    backtracks, LENGTH_ITERATIONS)
+                                    backtracks, iterations)
             if found is not None:
                 break
         entry = {"stage": f"check at step {state.step} (elements split in two)",
