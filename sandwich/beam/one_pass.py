@@ -17,7 +17,9 @@ the residual's share, up to ``max_core_level``), the state is re-converged there
 again, and the path goes on at the raised levels from the last state a check kept (the steps
 after it are taken again), so every state keeps the accuracy its check found. A raised model
 with no equilibrium near the checked state, or with another inertia there, has left this path's
-branch: the raise goes back to an earlier state. The estimate at the target is the run's.
+branch: the raise goes back to an earlier state. The estimate at the target is the run's, with
+the element length's share added there: the state re-converged with every element split in two
+at the same levels (:meth:`OnePass.length_estimate`), which only advises more elements.
 """
 
 from __future__ import annotations
@@ -67,8 +69,8 @@ LIFT_BACKTRACKS = 8
 #: Newton first (demo 13 iterations, d10 20; fig. 5 and fig. 6 fail it, 2.3 s), then with the
 #: line search (fig. 5 17, fig. 6 20; it fails the demo and d10 after 4-5 s).
 LENGTH_ITERATIONS = (22, 24)
-#: Newton's tolerance of an estimate's state (the path's where tighter): its answer to ~1e-6,
-#: far below any tolerance a scene asks for.
+#: Newton's tolerance of an estimate's state (the path's where that is looser): its answer to
+#: ~1e-6, far below any tolerance a scene asks for.
 ESTIMATE_TOL = 1e-6
 #: A state is at its target within this relative distance (the follower's own test is tighter).
 AT_TARGET = 1e-4
