@@ -187,9 +187,7 @@ class OnePass:
         lifted = self.lift(start, anchor.u, anchor.load_factor, dict(anchor.probes), levels,
                            self.model)
         self.choice.passes.append(self._entry(anchor, levels, lifted, "back to the last check"))
-        if lifted is None or None in (anchor.negative_pivots,
-                                      lifted[1].factorization.negative_pivots) or (
-                anchor.negative_pivots != lifted[1].factorization.negative_pivots):
+        if lifted is None or _same_inertia(anchor, lifted[1]) is not True:
             return checked, found
         return anchor, (levels, lifted[1])
 
@@ -204,24 +202,17 @@ class OnePass:
         """
         up = self.model if res is not None else None
         for older in reversed(earlier):
-            if res is not None and (None in (checked.negative_pivots,
-                                             res.factorization.negative_pivots)
-                                    or checked.negative_pivots
-                                    == res.factorization.negative_pivots):
+            if res is not None and _same_inertia(checked, res) is not False:
                 break
             lifted = self.lift(start, older.u, older.load_factor, dict(older.probes), levels, up)
-            entry = {"stage": f"check at step {older.step} (going back)",
-                     "elements_per_level": level_counts(levels),
-                     "load_factor": older.load_factor, "reached": lifted is not None,
-                     "estimate": None}
+            entry = self._entry(older, levels, lifted, "going back")
             self.choice.passes.append(entry)
             if lifted is None:
                 continue
             up, raised = lifted
             checked, res = older, raised
-            entry["load_factor"] = float(raised.load_factor)
-            entry["estimate"] = self.choice.estimate = answer_change(
-                older.load_factor, older.probes, float(raised.load_factor), _probes(up, raised.u))
+            entry["change"] = answer_change(older.load_factor, older.probes,
+                                            float(raised.load_factor), _probes(up, raised.u))
         if res is not None:
             self.model = up
         return checked, res
@@ -307,8 +298,7 @@ class OnePass:
         change, self.quantities = found
         estimate = self.quantities["load and probes"]
         entry["quantities"] = dict(self.quantities)
-        crossed = None not in (state.negative_pivots, res.factorization.negative_pivots) and (
-            res.factorization.negative_pivots != state.negative_pivots)
+        crossed = _same_inertia(state, res) is False
         entry.update(change=change, estimate=estimate, inertia_changed=crossed)
         return estimate, crossed, (look, up), res
 
@@ -546,6 +536,12 @@ def release_changes(before: dict[str, float | None],
     if mixes:
         out["G_II/G"] = max(mixes)
     return out
+
+
+def _same_inertia(state: PathState, res: object) -> bool | None:
+    """Whether ``res``'s factorised tangent has ``state``'s negative pivots (None: unknown)."""
+    a, b = state.negative_pivots, res.factorization.negative_pivots
+    return None if a is None or b is None else a == b
 
 
 def _probes(model: BeamModel, u: np.ndarray) -> dict[str, float]:
