@@ -20,7 +20,8 @@ import scipy.sparse as sp
 
 from sandwich.beam.assembly import ReducedPattern, reduced_pattern
 from sandwich.beam.contact import compact_response, penalty_response
-from sandwich.beam.contact_search import ContactPairs
+from sandwich.beam.contact_search import CORE_NODE_ROLES, ContactPairs
+from sandwich.beam.dofs import CONTACT_DOFS, NODE_DOFS, dof, global_dof
 from sandwich.beam.element import layer_state, layer_tangent
 from sandwich.solver.spares import free_array
 
@@ -144,9 +145,8 @@ class CompiledAssembly:
         contact = []
         for j, pairs in enumerate(model.pairs, start=len(families) + kept):
             if pairs.search == "closest-point":  # on each pair's chosen segment only
-                f10, K10, p, k, cols = compact_response(pairs, u_full, model.penalty,
-                                                        model.smoothing)
-                dofs10 = np.take_along_axis(pairs.support_dofs, cols, axis=1)
+                f10, K10, p, k, dofs10 = compact_response(pairs, u_full, model.penalty,
+                                                          model.smoothing)
                 forces.append(f10)
                 force_dofs[j] = dofs10
                 contact.append((p, k))
@@ -154,7 +154,7 @@ class CompiledAssembly:
                 sign = np.where(free >= 0, model.dof_map.sign[dofs10], 0).astype(np.int8)
                 K10 = np.ascontiguousarray(K10)
                 if self._scatter_compact(kernels, j, free, sign, K10, pattern, data):
-                    self.grow(_segments_around(pairs, cols))
+                    self.grow(_segments_around(pairs, dofs10))
                     return self.evaluate(u_full, kernels)
                 terms.append(ContactTerm(j, K10, (free, sign)))
                 continue
@@ -211,23 +211,25 @@ class CompiledAssembly:
         return f
 
 
-def _segments_around(pairs: ContactPairs, cols: np.ndarray) -> np.ndarray:
+def _segments_around(pairs: ContactPairs, dofs10: np.ndarray) -> np.ndarray:
     """Full DOFs (3m, 10) of each closest-point pair's chosen segment and its two neighbours.
 
-    ``cols`` are the chosen segment's 10 columns in ``support_dofs`` (:func:`compact_response`):
-    the face node's two, then core nodes ``seg`` and ``seg + 1``. A projection slides from
-    segment to segment, so the pattern grows by the neighbours too: the next slide finds its
-    couplings in place instead of rebuilding the pattern, slot maps and factorisation
-    structure (fig. 5 with auto levels: 22 rebuilds). A neighbour beyond the searched stretch
-    is the segment itself (duplicate rows are dropped by :meth:`CompiledAssembly.grow`).
+    ``dofs10`` are the chosen segments' 10 full DOFs (:func:`compact_response`): the face
+    node's two, then the core boundary DOFs of the segment's nodes a and a + 1. A projection
+    slides from segment to segment, so the pattern grows by the neighbours too: the next
+    slide finds its couplings in place instead of rebuilding the pattern, slot maps and
+    factorisation structure (fig. 5 with auto levels: 22 rebuilds). At a mesh end the
+    neighbour is the segment itself (duplicate rows are dropped by
+    :meth:`CompiledAssembly.grow`).
     """
-    segments = (pairs.support_dofs.shape[1] - 2) // 4 - 1
-    seg = (cols[:, 2] - 2) // 4
+    names = CONTACT_DOFS[pairs.interface]
+    a = (dofs10[:, 2] - dof(names["u_core"])) // NODE_DOFS  # the segment's first node
+    last = pairs.x.size - 2
     out = []
     for shift in (-1, 0, 1):
-        step = 4 * (np.clip(seg + shift, 0, segments - 1) - seg)
-        out.append(np.take_along_axis(pairs.support_dofs,
-                                      np.where(cols >= 2, cols + step[:, None], cols), axis=1))
+        n0 = np.clip(a + shift, 0, last)
+        core = [global_dof(n, names[r]) for n in (n0, n0 + 1) for r in CORE_NODE_ROLES]
+        out.append(np.column_stack([dofs10[:, :2], *core]))
     return np.concatenate(out)
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from sandwich.beam.contact_gap import PairKinematics, same_x_kinematics
 from sandwich.beam.contact_law import penalty_blocks
 from sandwich.beam.contact_projection import chosen_segment_kinematics, pair_block_kinematics
-from sandwich.beam.contact_search import ContactPairs
+from sandwich.beam.contact_search import ContactPairs, located
 
 
 def pair_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
@@ -37,8 +37,7 @@ def gap_change(
     """
     if pairs.search == "closest-point":
         c = chosen_segment_kinematics(pairs, u_full)
-        dofs = np.take_along_axis(pairs.support_dofs, c.cols, axis=1)
-        return c.gap, np.einsum("ij,ij->i", c.grad, du_full[dofs])
+        return c.gap, np.einsum("ij,ij->i", c.grad, du_full[c.dofs])
     k = pair_kinematics(pairs, u_full)
     return k.gap, np.einsum("ij,ij->i", k.grad, du_full[pairs.block_dofs])
 
@@ -46,9 +45,10 @@ def gap_change(
 def penalty_response(
     pairs: ContactPairs, u_full: np.ndarray, penalty: float, smoothing: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, PairKinematics]:
-    """Contact forces (m, 6), tangents (m, 6, 6), pressures (m,) MPa and the kinematics.
+    """Contact forces (m, n), tangents (m, n, n), pressures (m,) MPa and the kinematics.
 
-    ``smoothing`` is the regularisation width s (mm) of
+    On the pairs' blocks: same-x pairs' six DOFs, closest-point pairs' located windows
+    (:func:`block_rows`). ``smoothing`` is the regularisation width s (mm) of
     :func:`~sandwich.beam.contact_law.pressure_law`.
     """
     k = pair_kinematics(pairs, u_full)
@@ -62,17 +62,22 @@ def compact_response(
     """Closest-point pairs: :func:`penalty_response` on each pair's chosen segment only.
 
     Returns forces (m, 10), tangents (m, 10, 10), pressures (m,), the kinematics (gap,
-    sliding, ξ, segment, outside; gradient and Hessian on the 10 DOFs) and the 10 DOFs'
-    columns in the pair's block (``block_dofs``). The same numbers as the blocks of
-    :func:`penalty_response` at those DOFs (its other entries are zero), without forming the
-    (m, n, n) blocks: on a fine mesh the 1 mm reach spans dozens of segments.
+    sliding, ξ, segment, outside; gradient and Hessian on the 10 DOFs) and the 10 full DOFs.
+    The same numbers as the blocks of :func:`penalty_response` at those DOFs (its other
+    entries are zero), without forming the (m, n, n) blocks: on a fine mesh the 1 mm reach
+    spans dozens of segments.
     """
     if pairs.search != "closest-point":
         raise ValueError("compact_response is for closest-point pairs")
     c = chosen_segment_kinematics(pairs, u_full)
     f, K, p = penalty_blocks(c.gap, c.grad, c.hess, pairs.area, penalty, smoothing)
     k = PairKinematics(c.gap, c.grad, c.hess, c.sliding, c.xi, c.segment, c.outside)
-    return f, K, p, k, c.cols
+    return f, K, p, k, c.dofs
+
+
+def block_rows(pairs: ContactPairs, u_full: np.ndarray) -> np.ndarray:
+    """Full DOFs (m, n) of the blocks :func:`penalty_response` returns at ``u_full``."""
+    return located(pairs, u_full).block_dofs
 
 
 def contact_state(

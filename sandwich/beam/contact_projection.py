@@ -14,13 +14,18 @@ X_ξ = (a, c) = (l + Σ N'_k U_k, Σ N'_k W_k), the projection solves
 
     φ(ξ, q) = r · X_ξ = 0          (Newton: ξ ← ξ − φ/φ_ξ, φ_ξ = −|X_ξ|² + r·X_ξξ),
 
-vectorised over pairs and candidate segments (those within ``reach`` mm on each side of the node,
-at least one per side; at most 30 iterations, stopping when every |Δξ| < 1e-12). A candidate
+vectorised over pairs and candidate segments (those within ``reach`` mm on each side of the core
+node the master faces, at least one per side: the window follows the sliding,
+:func:`~sandwich.beam.contact_search.located`; at most 30 iterations, stopping when every
+|Δξ| < 1e-12). A candidate
 counts only if its Newton converged (|φ|/|X_ξ|² ≤ 1e-9) to a ξ in [0, 1]; the chosen one is the
 nearest (smallest |r|) of those. The core boundary is C¹ across nodes (shared slope DOFs), so at a
 node both neighbours give the same point, and between two distinct projections the nearest rule
-switches at equal distance, where g = ±|r| agrees. If no candidate counts (sliding beyond the
-searched reach) the pair is flagged ``outside`` and held at the nearer end of the searched
+switches at equal distance, where g = ±|r| agrees. A window moves when the facing node changes;
+the projection lies inside both windows then (the window holds ≥ 1 segment on each side of the
+facing point), so the gap does not notice. If no candidate counts (a projection farther than
+the reach from the facing point, or beyond a mesh end) the pair is flagged ``outside`` and held
+at the nearer end of the searched
 stretch at fixed ξ (ξ_q = 0): its gap n·r is the distance to the tangent line at that end, equal
 to the projection's gap when the projection leaves through that end (r ∥ n there), so g stays
 continuous and C¹ (g̃_ξ = 0 there) along any motion (docs/contact.md: the earlier
@@ -60,7 +65,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sandwich.beam.contact_gap import PairKinematics, gap_derivatives
-from sandwich.beam.contact_search import CORE_NODE_ROLES, NORMAL_SIGN, ContactPairs
+from sandwich.beam.contact_search import CORE_NODE_ROLES, NORMAL_SIGN, ContactPairs, located
 from sandwich.beam.dofs import CONTACT_DOFS, global_dof
 
 PROJECTION_TOL = 1e-12  # |Δξ| at which the projection Newton stops
@@ -128,10 +133,12 @@ class ChosenSegment:
     xi: np.ndarray
     segment: np.ndarray
     outside: np.ndarray
+    dofs: np.ndarray  # (m, 10) the full DOFs of the 10 columns
 
 
 def _kept_projection(pairs: ContactPairs, u_full: np.ndarray) -> ChosenSegment:
-    """:func:`closest_point_kinematics` of ``pairs``, kept for the next call at the same state."""
+    """:func:`closest_point_kinematics` of ``pairs`` (located), kept for the next call there."""
+    pairs = located(pairs, u_full)
     v = u_full[pairs.support_dofs]
     cached = getattr(pairs, "_last_compact", None)
     if cached is not None and np.array_equal(cached[0], v):
@@ -145,14 +152,19 @@ def forget_kinematics(pairs: ContactPairs) -> None:
     """Drop the closest-point kinematics kept for ``pairs`` (and their interface's parent)."""
     for p in (pairs, pairs.parent):
         if p is not None:
-            p.__dict__.pop("_last_compact", None)
-            p.__dict__.pop("_last", None)
+            kept = p.__dict__.get("_located")
+            for q in (p, None if kept is None else kept[1]):
+                if q is not None:
+                    q.__dict__.pop("_last_compact", None)
+                    q.__dict__.pop("_last", None)
 
 
 def chosen_segment_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> ChosenSegment:
     """Closest-point kinematics of ``pairs`` on their chosen segments, in their own layout.
 
-    A group of :func:`~sandwich.beam.contact_search.contact_pair_groups` reads its rows of the
+    On the windows located at ``u_full`` (:func:`~sandwich.beam.contact_search.located`; the
+    columns ``cols`` are in the located block). A group of
+    :func:`~sandwich.beam.contact_search.contact_pair_groups` reads its rows of the
     interface's one projection (``parent``) and shifts the block columns to its own, narrower
     block.
     """
@@ -164,7 +176,7 @@ def chosen_segment_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> Chosen
     cols = c.cols[rows]  # parent slot j ↔ own slot j − k_Δ
     return ChosenSegment(c.gap[rows], c.grad[rows], c.hess[rows],
                          np.where(cols >= 2, cols - shift, cols), c.sliding[rows], c.xi[rows],
-                         c.segment[rows] - shift // 4, c.outside[rows])
+                         c.segment[rows] - shift // 4, c.outside[rows], c.dofs[rows])
 
 
 def _on_block(pairs: ContactPairs, c: ChosenSegment) -> PairKinematics:
@@ -190,14 +202,19 @@ def _projection_residual(ξ, l, xa, U, W, xs, ws):
 
 
 def pair_block_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
-    """Closest-point kinematics of ``pairs`` on their whole blocks (``support_dofs``)."""
+    """Closest-point kinematics of ``pairs`` on their whole located blocks.
+
+    The block is ``located(pairs, u_full).block_dofs``
+    (:func:`~sandwich.beam.contact_search.located`).
+    """
     # the model asks for the force, then the tangent, at the same u: reuse the projection
-    v = u_full[pairs.support_dofs]
-    cached = getattr(pairs, "_last", None)
+    here = located(pairs, u_full)
+    v = u_full[here.support_dofs]
+    cached = here.__dict__.get("_last")
     if cached is not None and np.array_equal(cached[0], v):
         return cached[1]
-    k = _on_block(pairs, chosen_segment_kinematics(pairs, u_full))  # one projection for all groups
-    object.__setattr__(pairs, "_last", (v, k))
+    k = _on_block(here, chosen_segment_kinematics(pairs, u_full))  # one projection, all groups
+    object.__setattr__(here, "_last", (v, k))
     return k
 
 
@@ -226,7 +243,7 @@ def closest_point_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> ChosenS
                  np.ascontiguousarray(x_node + v_face[:, 0]), np.ascontiguousarray(v_face[:, 1]),
                  x_node, valid, NORMAL_SIGN[pairs.interface], PROJECTION_TOL,
                  PROJECTION_MAX_ITERATIONS, PROJECTION_RESIDUAL_TOL, IN_SEGMENT_TOL)
-    return ChosenSegment(*out)
+    return ChosenSegment(*out, np.take_along_axis(pairs.support_dofs, out[3], axis=1))
 
 
 def _kernel_geometry(pairs: ContactPairs) -> tuple[np.ndarray, ...]:
@@ -331,4 +348,5 @@ def closest_point_kinematics_numpy(pairs: ContactPairs, u_full: np.ndarray) -> C
     cols = np.concatenate([np.zeros((m, 1), int), np.ones((m, 1), int),
                            base + np.array([0, 1, 4, 5]), base + np.array([2, 3, 6, 7])], axis=1)
     sliding = xa[rows, seg] + ls * ξs - x_node[:, 0]
-    return ChosenSegment(gap, grad, hess, cols, sliding, ξs, seg, outside)
+    return ChosenSegment(gap, grad, hess, cols, sliding, ξs, seg, outside,
+                         np.take_along_axis(pairs.support_dofs, cols, axis=1))

@@ -12,10 +12,16 @@ Nodes strictly inside a debond are untied; at each of them the face's inner surf
   the *same material coordinate x* (:mod:`sandwich.beam.contact_gap`). It assumes small relative
   sliding; the sliding s = t·Δ is returned so a user can check it.
 
-A closest-point pair's force and tangent act on its block (face node + core nodes of the searched
-segments), so the sparse pattern is fixed; :func:`contact_pair_groups` groups an interface's
-pairs by search width (blocks no wider than needed on graded meshes) and the projection is
-computed once for all its groups.
+The closest-point search follows the sliding: its window of core segments (``reach`` mm on each
+side, at least one segment) is centred, at every evaluation, on the core node the master point
+faces in the deformed state — the node whose deformed x (x + u_c) is nearest the master's
+(:func:`located`) — not on the master's own node. A face may slide any distance along the core;
+the window only has to hold the projection's offset from the facing point (the gap times the
+slope), so its width, and each pair's work, does not grow with the sliding. A closest-point
+pair's force and tangent act on its chosen segment (:mod:`sandwich.beam.contact_projection`);
+its block is the located window's (face node + core nodes). :func:`contact_pair_groups`
+groups an interface's pairs by search width (blocks no wider than needed on graded meshes) and
+the projection is computed once for all its groups.
 """
 
 from __future__ import annotations
@@ -43,8 +49,10 @@ class ContactPairs:
     ``dofs`` are the node's own six same-x DOFs (PAIR_ROLES); the linear analysis
     (:func:`sandwich.beam.linear_step.linear_solution`) and the same-x search use them. A
     closest-point pair (``search == "closest-point"``) also carries the core boundary nodes
-    ``core_nodes`` (i − k … i + k, clamped to the mesh) whose segments it searches; its force and
-    tangent live on ``block_dofs`` = (u_face, w_face, then CORE_NODE_ROLES of each core node).
+    ``core_nodes`` (c − k … c + k, clamped to the mesh) whose segments it searches, c the node
+    it faces (its own node at rest; :func:`located` gives the pairs at a deformed state); its
+    force and tangent live on ``block_dofs`` = (u_face, w_face, then CORE_NODE_ROLES of each
+    core node). ``half_width`` (m,): each pair's own search half-width in segments.
     """
 
     interface: str
@@ -60,6 +68,7 @@ class ContactPairs:
     # computed once for all groups, and this group's rows in it
     parent: ContactPairs | None = None
     parent_rows: np.ndarray | None = None
+    half_width: np.ndarray | None = None  # (m,) closest-point: segments searched on each side
 
     @property
     def size(self) -> int:
@@ -106,9 +115,61 @@ def contact_pairs(
     raw = nodes[:, None] + np.arange(-k, k + 1)[None, :]
     core_nodes = np.clip(raw, lo[:, None], hi[:, None])
     valid = (raw[:, :-1] >= lo[:, None]) & (raw[:, 1:] <= hi[:, None])
+    half = np.maximum(np.maximum(nodes - lo, hi - nodes), 1)
+    return ContactPairs(interface, nodes, area, dofs, search, x, core_nodes, valid,
+                        _support(interface, dofs, core_nodes), half_width=half)
+
+
+def _support(interface: str, dofs: np.ndarray, core_nodes: np.ndarray) -> np.ndarray:
+    """Block DOFs of closest-point pairs: (u_face, w_face), then each core node's four."""
+    names = CONTACT_DOFS[interface]
     core = np.stack([global_dof(core_nodes, names[r]) for r in CORE_NODE_ROLES], axis=-1)
-    support = np.concatenate([dofs[:, :2], core.reshape(nodes.size, -1)], axis=1)
-    return ContactPairs(interface, nodes, area, dofs, search, x, core_nodes, valid, support)
+    return np.concatenate([dofs[:, :2], core.reshape(dofs.shape[0], -1)], axis=1)
+
+
+def facing_nodes(pairs: ContactPairs, u_full: np.ndarray) -> np.ndarray:
+    """The core node each closest-point pair's master point faces at ``u_full``.
+
+    The node whose deformed x, x + u_c, is nearest the master's x_i + u_face (the deformed
+    node positions made non-decreasing first, so that a sheared core cannot break the search).
+    """
+    x = pairs.x
+    core_u = pairs.__dict__.get("_core_u_dofs")
+    if core_u is None:
+        core_u = global_dof(np.arange(x.size), CONTACT_DOFS[pairs.interface]["u_core"])
+        object.__setattr__(pairs, "_core_u_dofs", core_u)
+    X = np.maximum.accumulate(x + u_full[core_u])
+    xs = x[pairs.nodes] + u_full[pairs.dofs[:, 0]]
+    j = np.clip(np.searchsorted(X, xs), 1, x.size - 1)
+    return np.where(xs - X[j - 1] < X[j] - xs, j - 1, j)
+
+
+def located(pairs: ContactPairs, u_full: np.ndarray) -> ContactPairs:
+    """Closest-point ``pairs`` with each window centred on the node it faces at ``u_full``.
+
+    The window keeps its width (``core_nodes.shape[1]``) and each pair its own half-width
+    (``half_width`` segments each side of the facing node, clamped to the mesh). ``pairs``
+    itself where every pair faces its own node (at rest); the last located pairs are kept
+    for the next call with the same facing nodes. Same-x pairs: ``pairs``.
+    """
+    if pairs.search != "closest-point" or pairs.size == 0:
+        return pairs
+    centre = facing_nodes(pairs, u_full)
+    if np.array_equal(centre, pairs.nodes):
+        return pairs
+    cached = pairs.__dict__.get("_located")
+    if cached is not None and np.array_equal(cached[0], centre):
+        return cached[1]
+    k = pairs.core_nodes.shape[1] // 2
+    lo = np.maximum(centre - pairs.half_width, 0)
+    hi = np.minimum(centre + pairs.half_width, pairs.x.size - 1)
+    raw = centre[:, None] + np.arange(-k, k + 1)[None, :]
+    core_nodes = np.clip(raw, lo[:, None], hi[:, None])
+    valid = (raw[:, :-1] >= lo[:, None]) & (raw[:, 1:] <= hi[:, None])
+    out = dataclasses.replace(pairs, core_nodes=core_nodes, segment_valid=valid,
+                              support_dofs=_support(pairs.interface, pairs.dofs, core_nodes))
+    object.__setattr__(pairs, "_located", (centre, out))
+    return out
 
 
 def _search_range(nodes: np.ndarray, x: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:

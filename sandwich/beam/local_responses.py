@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from sandwich.beam.assembly import scatter_vector
-from sandwich.beam.contact import compact_response, penalty_response
+from sandwich.beam.contact import block_rows, compact_response, penalty_response
 from sandwich.beam.element import LayerState, layer_state, layer_tangent
 
 CHUNK = 1024  # elements per vectorised block (bounds memory at large element counts)
@@ -39,7 +39,13 @@ def reference_forces(
         forces.append(np.concatenate([st.f for st in family]))
     for pairs in model.pairs:
         forces.append(penalty_response(pairs, u_full, model.penalty, model.smoothing)[0])
-    return scatter_vector(u_full.size, model.block_dofs, forces), states
+    return scatter_vector(u_full.size, reference_rows(model, u_full), forces), states
+
+
+def reference_rows(model: object, u_full: np.ndarray) -> list[np.ndarray]:
+    """Full DOFs of the NumPy path's blocks at ``u_full``: layers, then contact (located)."""
+    layers = model.block_dofs[:len(model.block_dofs) - len(model.pairs)]
+    return layers + [block_rows(pairs, u_full) for pairs in model.pairs]
 
 
 def reference_tangent_blocks(
@@ -85,14 +91,14 @@ def compiled_local_responses(
         blocks.append(K)
     for pairs in model.pairs:
         if pairs.search == "closest-point" and not (tangent and contact_blocks):
-            f10, _, _, _, cols = compact_response(pairs, u_full, model.penalty, model.smoothing)
-            f = np.zeros(pairs.support_dofs.shape)
-            np.put_along_axis(f, cols, f10, axis=1)
-            forces.append(f)
+            f10, _, _, _, dofs10 = compact_response(pairs, u_full, model.penalty,
+                                                    model.smoothing)
+            forces.append(f10)
+            rows.append(dofs10)
             continue
         f, K, _, _ = penalty_response(pairs, u_full, model.penalty, model.smoothing)
         forces.append(f)
+        rows.append(block_rows(pairs, u_full))
         if contact_blocks:
             blocks.append(K)
-    rows += [pairs.block_dofs for pairs in model.pairs]
     return rows, forces, blocks

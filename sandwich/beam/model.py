@@ -37,6 +37,7 @@ from sandwich.beam.layer_operators import LayerOperators
 from sandwich.beam.local_responses import (
     compiled_local_responses,
     reference_forces,
+    reference_rows,
     reference_tangent_blocks,
 )
 from sandwich.beam.mesh import BeamMesh
@@ -125,12 +126,30 @@ class BeamModel:
 
     @cached_property
     def full_pattern(self) -> ReducedPattern:
-        """The pattern of every block family on its whole DOF list (the NumPy path's).
+        """The pattern of every block family on its whole DOF list (the NumPy path's, at rest).
 
-        For closest-point pairs: all searched segments. Built on first use.
+        For closest-point pairs: all searched segments of the windows at rest. Built on first
+        use.
         """
         return (self.pattern if not any(p.search == "closest-point" for p in self.pairs)
                 else reduced_pattern(self.block_dofs, self.dof_map))
+
+    def reference_pattern(self, u_full: np.ndarray) -> ReducedPattern:
+        """The NumPy path's pattern at ``u_full``: the closest-point windows located there.
+
+        :attr:`full_pattern` where every window is at rest; else built for the located
+        windows (the last one kept).
+        """
+        rows = reference_rows(self, u_full)
+        if all(r is b for r, b in zip(rows, self.block_dofs, strict=True)):
+            return self.full_pattern
+        kept = self.__dict__.get("_located_pattern")
+        if kept is not None and all(np.array_equal(a, b) for a, b in zip(kept[0], rows,
+                                                                          strict=True)):
+            return kept[1]
+        pattern = reduced_pattern(rows, self.dof_map)
+        self.__dict__["_located_pattern"] = (rows, pattern)
+        return pattern
 
     @property
     def face_extra(self) -> int:
@@ -304,8 +323,9 @@ class BeamModel:
             if not tangent or last.tangent is not None:
                 return last.force, last.tangent
             # The force at this u is known: the tangent reuses its strains and stresses.
-            last.tangent = self.full_pattern.assemble(
-                reference_tangent_blocks(self, self.expand(u), last.states))
+            u_full = self.expand(u)
+            last.tangent = self.reference_pattern(u_full).assemble(
+                reference_tangent_blocks(self, u_full, last.states))
             return last.force, last.tangent
         u_full = self.expand(u)
         u_kept = np.array(u, dtype=float, copy=True)
@@ -316,7 +336,7 @@ class BeamModel:
             return f, assembled.K
         f_full, states = reference_forces(self, u_full)
         f = self.dof_map.reduce(f_full)
-        K = (self.full_pattern.assemble(reference_tangent_blocks(self, u_full, states))
+        K = (self.reference_pattern(u_full).assemble(reference_tangent_blocks(self, u_full, states))
              if tangent else None)
         self.last_evaluation = Evaluation(u_kept, f, K, states=states)
         return f, K

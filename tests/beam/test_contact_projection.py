@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from sandwich.beam import build_model, run
-from sandwich.beam.contact import pair_kinematics, penalty_response
+from sandwich.beam.contact import block_rows, pair_kinematics, penalty_response
 from sandwich.beam.contact_law import contact_energy
 from sandwich.beam.contact_projection import (
     closest_point_kernel,
@@ -28,7 +28,13 @@ from sandwich.beam.contact_projection import (
     closest_point_kinematics_numpy,
     hermite_basis,
 )
-from sandwich.beam.contact_search import NORMAL_SIGN, contact_pair_groups, contact_pairs
+from sandwich.beam.contact_search import (
+    NORMAL_SIGN,
+    contact_pair_groups,
+    contact_pairs,
+    facing_nodes,
+    located,
+)
 from sandwich.beam.dofs import CONTACT_DOFS, NODE_DOFS, global_dof
 from sandwich.beam.shape_functions import x_shape
 from sandwich.scene_file import load_scene
@@ -91,9 +97,10 @@ def _state(interface, slide, gap, theta=0.3, amp=0.4, x=X, nodes=NODES):
     return u
 
 
-def _global(pairs, m, local):
-    """A pair's block vector (n,) or matrix (n, n) on the full DOFs (repeated DOFs summed)."""
-    d = pairs.block_dofs[m]
+def _global(pairs, m, local, u):
+    """A pair's block vector (n,) or matrix (n, n) at state ``u`` on the full DOFs (repeated
+    DOFs summed): the block of the window located at ``u``."""
+    d = block_rows(pairs, u)[m]
     n = NODE_DOFS * X.size
     if local.ndim == 1:
         return np.bincount(d, weights=local, minlength=n)
@@ -136,7 +143,7 @@ def test_known_closest_point_including_crossing_into_next_segments(interface):
     assert np.allclose(k.gap, gap, rtol=0, atol=1e-12)
     assert np.allclose(k.sliding, slide, rtol=0, atol=1e-11)
     # the chosen segment holds the material point x_i + d_i
-    seg_nodes = pairs.core_nodes[np.arange(pairs.size), k.segment]
+    seg_nodes = located(pairs, u).core_nodes[np.arange(pairs.size), k.segment]
     left = X[seg_nodes]
     target = X[NODES] + slide
     assert np.all((left <= target + 1e-12) & (target <= X[seg_nodes + 1] + 1e-12))
@@ -153,8 +160,8 @@ def test_gap_and_force_continuous_when_the_projection_crosses_a_node():
         slide = np.array([0.0, d, 0.0, 0.0, 0.0, 0.0])
         u = _state("top", slide, np.full(6, -1e-3))
         f, _, _, k = penalty_response(pairs, u, EPS, S)
-        forces.append(_global(pairs, 1, f[1]))
-        segs.append(int(pairs.core_nodes[1, k.segment[1]]))
+        forces.append(_global(pairs, 1, f[1], u))
+        segs.append(int(located(pairs, u).core_nodes[1, k.segment[1]]))
     assert segs == [2, 3]  # [3, 4.5] then [4.5, 5]
     assert np.linalg.norm(forces[1] - forces[0]) < 1e-6 * np.linalg.norm(forces[0])
 
@@ -169,7 +176,7 @@ def test_zero_sliding_gives_the_same_x_gap(interface):
     assert np.allclose(kc.gap, ks.gap, rtol=0, atol=1e-13)
     assert np.allclose(kc.sliding, 0.0, atol=1e-12) and np.allclose(ks.sliding, 0.0, atol=1e-12)
     for m in range(closest.size):
-        gc = _global(closest, m, kc.grad[m])
+        gc = _global(closest, m, kc.grad[m], u)
         gs = np.bincount(same_x.dofs[m], weights=ks.grad[m], minlength=u.size)
         assert np.allclose(gc, gs, rtol=0, atol=1e-12)
 
@@ -197,9 +204,9 @@ def test_consistent_tangent_with_sliding_and_rotation(interface):
     assert np.all(p > 0) and not k.outside.any()
     h = 1e-6
     for m in range(pairs.size):
-        dofs = np.unique(pairs.block_dofs[m])
-        G, H = _global(pairs, m, k.grad[m]), _global(pairs, m, k.hess[m])
-        F, KK = _global(pairs, m, f[m]), _global(pairs, m, K[m])
+        dofs = np.unique(block_rows(pairs, u)[m])
+        G, H = _global(pairs, m, k.grad[m], u), _global(pairs, m, k.hess[m], u)
+        F, KK = _global(pairs, m, f[m], u), _global(pairs, m, K[m], u)
         fd_g, fd_G, fd_F, fd_W = (np.zeros(u.size), np.zeros((u.size, u.size)),
                                   np.zeros((u.size, u.size)), np.zeros(u.size))
         for j in dofs:
@@ -208,8 +215,10 @@ def test_consistent_tangent_with_sliding_and_rotation(interface):
             fp, _, _, kp = penalty_response(pairs, u + du, EPS, S)
             fm, _, _, km = penalty_response(pairs, u - du, EPS, S)
             fd_g[j] = (kp.gap[m] - km.gap[m]) / (2 * h)
-            fd_G[:, j] = (_global(pairs, m, kp.grad[m]) - _global(pairs, m, km.grad[m])) / (2 * h)
-            fd_F[:, j] = (_global(pairs, m, fp[m]) - _global(pairs, m, fm[m])) / (2 * h)
+            fd_G[:, j] = (_global(pairs, m, kp.grad[m], u + du)
+                          - _global(pairs, m, km.grad[m], u - du)) / (2 * h)
+            fd_F[:, j] = (_global(pairs, m, fp[m], u + du)
+                          - _global(pairs, m, fm[m], u - du)) / (2 * h)
             fd_W[j] = pairs.area[m] * (contact_energy(kp.gap[m], EPS, S)
                                        - contact_energy(km.gap[m], EPS, S)) / (2 * h)
         assert np.allclose(G, fd_g, rtol=0, atol=1e-8 * np.abs(G).max())
@@ -278,13 +287,14 @@ def test_consistent_tangent_with_sliding_inside_the_smoothing_band():
     # ~1e-15 mm and smaller steps lose digits (1e-4 s: 4e-6 of max|K|); the law varies over ~s
     h = 1e-3 * S
     for m in range(pairs.size):
-        dofs = np.unique(pairs.block_dofs[m])
-        KK = _global(pairs, m, K[m])
+        dofs = np.unique(block_rows(pairs, u)[m])
+        KK = _global(pairs, m, K[m], u)
         for j in dofs:
             du = np.zeros_like(u)
             du[j] = h
-            fd = (_global(pairs, m, penalty_response(pairs, u + du, EPS, S)[0][m])
-                  - _global(pairs, m, penalty_response(pairs, u - du, EPS, S)[0][m])) / (2 * h)
+            fd = (_global(pairs, m, penalty_response(pairs, u + du, EPS, S)[0][m], u + du)
+                  - _global(pairs, m, penalty_response(pairs, u - du, EPS, S)[0][m], u - du)
+                  ) / (2 * h)
             assert np.allclose(KK[:, j], fd, rtol=1e-5, atol=1e-6 * np.abs(KK).max())
 
 
@@ -308,7 +318,7 @@ def test_groups_by_search_width_give_the_ungrouped_force_and_tangent():
         F, K, gaps = np.zeros(n), np.zeros((n, n)), {}
         for p in pair_list:
             f, k_blocks, _, kin = penalty_response(p, u, EPS, S)
-            d = p.block_dofs
+            d = block_rows(p, u)
             np.add.at(F, d, f)
             np.add.at(K, (d[:, :, None], d[:, None, :]), k_blocks)
             gaps.update(zip(p.nodes.tolist(), kin.gap, strict=True))
@@ -355,63 +365,93 @@ def _sliding_state(interface, d, gap):
 
 
 @pytest.mark.parametrize("interface", ["top", "bottom"])
-def test_gap_continuous_when_the_projection_leaves_the_searched_segments(interface):
-    # regression: beyond the reach the old fallback extrapolated the "least outside" segment,
-    # whose Newton stalled at ξ = 1.5 on several segments alike; the pick among them flipped with
-    # round-off and the gap jumped (c3, 240 elements: 0.052 → −0.011 mm, ‖f_int‖ by 2e5 N)
+def test_the_search_window_follows_the_sliding(interface):
+    # a face node slid ±2 mm along a rotated, wavy core: eight segments each way, twice its
+    # 1 mm reach at rest. Reference: the construction (the node at X(x_i + d) + g0 n: gap g0,
+    # sliding d exactly). The window is centred on the node faced, so no pair is ever outside
     pairs = contact_pairs(interface, np.array([NODE_U]), XU, 60.0, search="closest-point",
                           reach=1.0)
     g0 = -1e-3
     ds = np.linspace(-2.0, 2.0, 801)  # steps of 5e-3 mm
-    ks = [pair_kinematics(pairs, _sliding_state(interface, d, g0)) for d in ds]
+    states = [_sliding_state(interface, d, g0) for d in ds]
+    ks = [pair_kinematics(pairs, u) for u in states]
+    assert not any(bool(k.outside[0]) for k in ks)
+    np.testing.assert_allclose([k.gap[0] for k in ks], g0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose([k.sliding[0] for k in ks], ds, rtol=0, atol=1e-11)
+    faced = np.array([int(facing_nodes(pairs, u)[0]) for u in states])
+    assert faced.min() <= NODE_U - 8 and faced.max() >= NODE_U + 8  # the window moved
+    # where the window moves the gradient on the full DOFs does not notice (central
+    # differences of the gap at the switch: the same gradient)
+    moves = np.flatnonzero(np.diff(faced))
+    n = NODE_DOFS * XU.size
+    for i in moves[:3]:
+        grads = []
+        for d in (ds[i], ds[i + 1]):
+            u = _sliding_state(interface, d, g0)
+            k = pair_kinematics(pairs, u)
+            grads.append(np.bincount(block_rows(pairs, u)[0], weights=k.grad[0], minlength=n))
+        assert np.linalg.norm(grads[1] - grads[0]) < 0.05 * np.linalg.norm(grads[0])
+
+
+def _held(pairs, u):
+    """Kinematics on the windows as they are (not located): the fallback beyond them."""
+    return closest_point_kinematics(pairs, u)
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_gap_continuous_when_the_projection_leaves_the_searched_segments(interface):
+    # the fallback of a projection beyond its window (a mesh end, or farther than the reach
+    # from the node faced), on the windows at rest. Regression: the old fallback extrapolated
+    # the "least outside" segment, whose Newton stalled at ξ = 1.5 on several segments alike;
+    # the pick among them flipped with round-off and the gap jumped (c3, 240 elements:
+    # 0.052 → −0.011 mm, ‖f_int‖ by 2e5 N)
+    pairs = contact_pairs(interface, np.array([NODE_U]), XU, 60.0, search="closest-point",
+                          reach=1.0)
+    g0 = -1e-3
+    ds = np.linspace(-2.0, 2.0, 801)  # steps of 5e-3 mm
+    ks = [_held(pairs, _sliding_state(interface, d, g0)) for d in ds]
     gaps = np.array([k.gap[0] for k in ks])
     outside = np.array([bool(k.outside[0]) for k in ks])
     within = np.abs(ds) < 1.0 - 1e-9
     assert not outside[within].any() and outside[np.abs(ds) > 1.0 + 1e-9].all()
     assert np.allclose(gaps[within], g0, rtol=0, atol=1e-12)  # exact while searched
-    # continuous: beyond the reach the gap is the distance to the tangent line at the searched
-    # stretch's end, which departs from g0 with the core's curvature (slope ≤ 0.03 here; the old
-    # fallback jumped by 0.055 mm at d = 1.125)
+    # continuous: beyond the window the gap is the distance to the tangent line at its end,
+    # which departs from g0 with the core's curvature (slope ≤ 0.03 here; the old fallback
+    # jumped by 0.055 mm at d = 1.125)
     assert np.max(np.abs(np.diff(gaps))) < 0.1 * (ds[1] - ds[0])
     # and C¹ at the exit: the gradient on either side of |d| = reach agrees
     for edge in (-1.0, 1.0):
         grads = []
         for d in (edge - 1e-7, edge + 1e-7):
-            k = pair_kinematics(pairs, _sliding_state(interface, d, g0))
-            grads.append(np.bincount(pairs.block_dofs[0], weights=k.grad[0],
+            k = _held(pairs, _sliding_state(interface, d, g0))
+            grads.append(np.bincount(k.dofs[0], weights=k.grad[0],
                                      minlength=NODE_DOFS * XU.size))
         assert np.linalg.norm(grads[1] - grads[0]) < 1e-5 * np.linalg.norm(grads[0])
 
 
 @pytest.mark.parametrize("interface", ["top", "bottom"])
-def test_consistent_tangent_beyond_the_searched_segments(interface):
+def test_consistent_gap_derivatives_beyond_the_searched_segments(interface):
+    # the held fallback's gradient and Hessian (ξ fixed at the window's end) against central
+    # differences of its own gap
     pairs = contact_pairs(interface, np.array([NODE_U]), XU, 60.0, search="closest-point",
                           reach=1.0)
     u = _sliding_state(interface, 1.4, -2e-2)
-    f, K, p, k = penalty_response(pairs, u, EPS, S)
-    assert k.outside[0] and p[0] > 0
-    d = pairs.block_dofs[0]
+    k = _held(pairs, u)
+    assert k.outside[0]
+    d = k.dofs[0]
     n = NODE_DOFS * XU.size
-
-    def glob(local):
-        if local.ndim == 1:
-            return np.bincount(d, weights=local, minlength=n)
-        out = np.zeros((n, n))
-        np.add.at(out, (d[:, None], d[None, :]), local)
-        return out
-
-    G, F, KK = glob(k.grad[0]), glob(f[0]), glob(K[0])
+    G = np.bincount(d, weights=k.grad[0], minlength=n)
+    H = np.zeros((n, n))
+    np.add.at(H, (d[:, None], d[None, :]), k.hess[0])
     h = 1e-6
     for j in np.unique(d):
         du = np.zeros_like(u)
         du[j] = h
-        fp, _, _, kp = penalty_response(pairs, u + du, EPS, S)
-        fm, _, _, km = penalty_response(pairs, u - du, EPS, S)
+        kp, km = _held(pairs, u + du), _held(pairs, u - du)
         assert (kp.gap[0] - km.gap[0]) / (2 * h) == pytest.approx(G[j], abs=1e-8 * np.abs(G).max())
-        fd = (glob(fp[0]) - glob(fm[0])) / (2 * h)
-        assert np.allclose(KK[:, j], fd, rtol=0, atol=1e-6 * np.abs(KK).max())
-        W = pairs.area[0] * (contact_energy(kp.gap[0], EPS, S) - contact_energy(km.gap[0], EPS, S))
-        assert W / (2 * h) == pytest.approx(F[j], abs=1e-6 * np.abs(F).max())
+        fd = (np.bincount(kp.dofs[0], weights=kp.grad[0], minlength=n)
+              - np.bincount(km.dofs[0], weights=km.grad[0], minlength=n)) / (2 * h)
+        assert np.allclose(H[:, j], fd, rtol=0, atol=1e-6 * np.abs(H).max())
 
 
 @pytest.mark.parametrize("interface", ["top", "bottom"])
