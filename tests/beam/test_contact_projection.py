@@ -532,3 +532,39 @@ def test_c3_cantilever_slides_beyond_the_reach_with_every_pair_in_its_window():
     assert sliding > 3.0
     summary = out.model.contact_summary(out.states[-1].u)
     assert sum(c.outside_reach for c in summary.values()) == 0
+
+
+@pytest.mark.parametrize("interface", ["top", "bottom"])
+def test_patch_a_face_sliding_several_segments_transmits_its_pressure_exactly(interface):
+    # patch test: a flat, rotated (rigid) core; every face node of a stretch slid by 3.3
+    # segments along it and pressed in by the same depth. Reference (closed form): each pair
+    # carries the law's pressure p(g0) on its tributary area, normal to the core; the face gets
+    # Σ p A along the normal, the core the opposite (equilibrium), nothing tangential
+    # (frictionless), at every slide across the segments
+    theta = 0.2
+    nodes = np.arange(12, 37)
+    g0 = -30.0 * S
+    p0 = contact_energy(np.array([g0 - 1e-9, g0 + 1e-9]), EPS, S)
+    p0 = -(p0[1] - p0[0]) / 2e-9  # the law's pressure at g0: −dW/dg
+    pairs = contact_pairs(interface, nodes, XU, 60.0, search="closest-point", reach=1.0)
+    names = CONTACT_DOFS[interface]
+    s_n = NORMAL_SIGN[interface]
+    t = np.array([np.cos(theta), np.sin(theta)])
+    n = s_n * np.array([-t[1], t[0]])
+    for slide in (3.3 * 0.25, 3.3 * 0.25 + 0.11, -2.6 * 0.25):
+        u = _state(interface, np.full(nodes.size, slide), np.full(nodes.size, g0), theta=theta,
+                   amp=0.0, x=XU, nodes=nodes)
+        f, _, p, k = penalty_response(pairs, u, EPS, S)
+        assert not k.outside.any()
+        np.testing.assert_allclose(k.sliding, slide, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(p, p0, rtol=1e-9)
+        F = np.zeros(u.size)
+        np.add.at(F, block_rows(pairs, u), f)
+        face = np.array([F[global_dof(nodes, names["u_face"])],
+                         F[global_dof(nodes, names["w_face"])]])  # (2, m)
+        total = p0 * pairs.area.sum()
+        np.testing.assert_allclose(face.T @ n, -p0 * pairs.area, rtol=1e-9)  # pushed out
+        np.testing.assert_allclose(face.T @ t, 0.0, atol=1e-9 * total)  # frictionless
+        core = np.array([F[global_dof(np.arange(XU.size), names["u_core"])].sum(),
+                         F[global_dof(np.arange(XU.size), names["w_core"])].sum()])
+        np.testing.assert_allclose(core, -face.sum(axis=1), rtol=1e-9, atol=1e-9 * total)
