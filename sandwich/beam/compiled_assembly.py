@@ -5,9 +5,10 @@ element's tangent straight into the CSR values of the reduced matrix through the
 maps; the contact groups' blocks are added by slot map (same-x) or, for closest-point pairs, on
 each pair's chosen segment only (:func:`sandwich.beam.kernels.scatter_compact_known`). The
 pattern holds the layers and, of each closest-point pair, the segments next to its node; it
-grows by the segments the projections meet (:meth:`CompiledAssembly.grow`). A Newton iterate
-asks for the tangent at every u whose residual it evaluates (fig. 5: 139 forces, 140 tangents),
-so the tangent comes with every force.
+grows by the segments the projections of pairs in contact meet (:meth:`CompiledAssembly.grow`;
+an open pair's block is zero and needs no slots). A Newton iterate asks for the tangent at
+every u whose residual it evaluates (fig. 5: 139 forces, 140 tangents), so the tangent comes
+with every force.
 """
 
 from __future__ import annotations
@@ -150,7 +151,10 @@ class CompiledAssembly:
                 forces.append(f10)
                 force_dofs[j] = dofs10
                 contact.append((p, k))
-                free = np.ascontiguousarray(model.dof_map.free[dofs10], dtype=np.int64)
+                # an open pair's block is exactly zero (the law is nil for g ≥ 0): it needs no
+                # slots, so the pattern grows only by the segments of pairs in contact
+                free = np.where(k.gap[:, None] >= 0.0, -1, model.dof_map.free[dofs10])
+                free = np.ascontiguousarray(free, dtype=np.int64)
                 sign = np.where(free >= 0, model.dof_map.sign[dofs10], 0).astype(np.int8)
                 K10 = np.ascontiguousarray(K10)
                 if self._scatter_compact(kernels, j, free, sign, K10, pattern, data):

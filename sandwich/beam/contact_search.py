@@ -114,9 +114,10 @@ def contact_pairs(
     if not (np.isfinite(reach) and reach >= 0):
         raise ValueError(f"contact reach must be >= 0 mm, got {reach!r}")
     # Each node searches the core nodes lo..hi: the segments covering `reach` mm on each side
-    # (at least one segment and at most MAX_WINDOW per side, stopping at the mesh ends). A common width 2k + 1 keeps the
-    # arrays rectangular; slots beyond a node's own range repeat its end node (no extra coupling
-    # in the sparse pattern) and their segments are marked invalid.
+    # (at least one segment and at most MAX_WINDOW per side, stopping at the mesh ends). A
+    # common width 2k + 1 keeps the arrays rectangular; slots beyond a node's own range repeat
+    # its end node (no extra coupling in the sparse pattern) and their segments are marked
+    # invalid.
     lo, hi = _search_range(nodes, x, reach)
     k = int(max(np.max(nodes - lo, initial=1), np.max(hi - nodes, initial=1)))
     raw = nodes[:, None] + np.arange(-k, k + 1)[None, :]
@@ -180,8 +181,10 @@ def located(pairs: ContactPairs, u_full: np.ndarray) -> ContactPairs:
 
 
 def _search_range(nodes: np.ndarray, x: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """First and last core node each face node searches: ``reach`` mm each side, ≥ 1 segment,
-    ≤ ``MAX_WINDOW`` segments."""
+    """First and last core node each face node searches: ``reach`` mm each side.
+
+    At least one segment and at most ``MAX_WINDOW`` on each side, within the mesh.
+    """
     tol = 1e-12 * (x[-1] - x[0])
     lo = np.searchsorted(x, x[nodes] - reach + tol, side="right") - 1
     lo = np.clip(np.minimum(lo, nodes - 1), np.maximum(nodes - MAX_WINDOW, 0), None)
