@@ -42,7 +42,6 @@ BEAM_ROWS = [  # (role, elements, core)
     ("fit", 2000, "1"), ("fit", 4000, "1"), ("fit", 8000, "1"),
     ("fit", 2000, "3"), ("fit", 4000, "3"), ("fit", 8000, "3"),
     ("check", 2000, "5"), ("check", 1000, "4"), ("check", 4000, "auto"),
-    ("check", 16000, "1"),
 ]
 TWO_D_ROWS = [  # (role, command, level, refine)
     ("fit", "mesh", "coarse", 0), ("fit", "mesh", "medium", 0), ("fit", "mesh", "coarse", 1),
