@@ -64,8 +64,8 @@ def compact_response(
     Returns forces (m, 10), tangents (m, 10, 10), pressures (m,), the kinematics (gap,
     sliding, ξ, segment, outside; gradient and Hessian on the 10 DOFs) and the 10 full DOFs.
     The same numbers as the blocks of :func:`penalty_response` at those DOFs (its other
-    entries are zero), without forming the (m, n, n) blocks: on a fine mesh the 1 mm reach
-    spans dozens of segments.
+    entries are zero), without forming the (m, n, n) blocks (a window holds up to 17
+    segments).
     """
     if pairs.search != "closest-point":
         raise ValueError("compact_response is for closest-point pairs")

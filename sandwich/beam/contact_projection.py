@@ -15,21 +15,20 @@ X_ξ = (a, c) = (l + Σ N'_k U_k, Σ N'_k W_k), the projection solves
     φ(ξ, q) = r · X_ξ = 0          (Newton: ξ ← ξ − φ/φ_ξ, φ_ξ = −|X_ξ|² + r·X_ξξ),
 
 vectorised over pairs and candidate segments (those within ``reach`` mm on each side of the core
-node the master faces, at least one per side: the window follows the sliding,
-:func:`~sandwich.beam.contact_search.located`; at most 30 iterations, stopping when every
-|Δξ| < 1e-12). A candidate
-counts only if its Newton converged (|φ|/|X_ξ|² ≤ 1e-9) to a ξ in [0, 1]; the chosen one is the
-nearest (smallest |r|) of those. The core boundary is C¹ across nodes (shared slope DOFs), so at a
-node both neighbours give the same point, and between two distinct projections the nearest rule
-switches at equal distance, where g = ±|r| agrees. A window moves when the facing node changes;
-the projection lies inside both windows then (the window holds ≥ 1 segment on each side of the
-facing point), so the gap does not notice. If no candidate counts (a projection farther than
-the reach from the facing point, or beyond a mesh end) the pair is flagged ``outside`` and held
-at the nearer end of the searched
-stretch at fixed ξ (ξ_q = 0): its gap n·r is the distance to the tangent line at that end, equal
-to the projection's gap when the projection leaves through that end (r ∥ n there), so g stays
-continuous and C¹ (g̃_ξ = 0 there) along any motion (docs/contact.md: the earlier
-fallback, an extrapolated "least outside" segment, made the c3 cantilever's internal force jump).
+node the master faces, at least one and at most 8 per side: the window follows the sliding,
+:func:`~sandwich.beam.contact_search.located`; at most 30 iterations, stopping when every |Δξ| <
+1e-12). A candidate counts only if its Newton converged (|φ|/|X_ξ|² ≤ 1e-9) to a ξ in [0, 1];
+the chosen one is the nearest (smallest |r|) of those. The core boundary is C¹ across nodes
+(shared slope DOFs), so at a node both neighbours give the same point, and between two distinct
+projections the nearest rule switches at equal distance, where g = ±|r| agrees. A window moves
+when the facing node changes; the projection lies inside both windows then (the window holds ≥ 1
+segment on each side of the facing point), so the gap does not notice. If no candidate counts (a
+projection farther than the window from the facing point, or beyond a mesh end) the pair is
+flagged ``outside`` and held at the nearer end of the searched stretch at fixed ξ (ξ_q = 0): its
+gap n·r is the distance to the tangent line at that end, equal to the projection's gap when the
+projection leaves through that end (r ∥ n there), so g stays continuous and C¹ (g̃_ξ = 0 there)
+along any motion (docs/contact.md: the earlier fallback, an extrapolated "least outside"
+segment, made the c3 cantilever's internal force jump).
 The gap along the slave's deformed normal n = s_n (−c, a)/ℓ, ℓ = |X_ξ|, is
 
     g̃(ξ, q) = n · r = s_n (a r₂ − c r₁)/ℓ,      g(q) = g̃(ξ(q), q),
