@@ -1,23 +1,44 @@
-"""Frictionless unilateral contact between the lips of a debond: small-sliding node-to-surface.
+"""Frictionless unilateral contact between the lips of a debond: finite-sliding node-to-surface.
 
-Slave nodes are the face-lip nodes; each is paired with the coincident core-lip node (its anchor,
-x_0). The master surface near the anchor is the tangent line of the deformed core lip there, with
-its direction taken from the chord of the anchor's two neighbours on the core lip, x_1 → x_2
-(the crack-tip nodes close the chain; at an open mouth, where the debond reaches the beam
-end, the last chord is one-sided: the anchor and its single neighbour). The gap is the signed
-distance of the slave from that line along its normal n = J (x_2 − x_1)/|x_2 − x_1|, J a +90°
-rotation, the chain being ordered so that n points out of the core:
+Slave nodes are the face-lip nodes; the master is the chain of core-lip nodes (the crack-tip
+nodes close it; at an open mouth, where the debond reaches the beam end, it ends at the lip's
+last node), ordered so that the normal n = J t, J a +90° rotation, points out of the core.
 
-    g = n · (x_s − x_0) = (x_2 − x_1) × (x_s − x_0) / |x_2 − x_1|.
+**Tangent line at a master node.** The master surface at chain node a is the line through x_a
+along the chord of its two neighbours, x_{a−1} → x_{a+1} (one-sided at the chain's ends). The
+signed distance of a slave x_s from it is
 
-This is the "small-sliding" node-to-surface formulation (the slave stays near its anchor; the
-tangential slip (x_s − x_0) · t is reported so that this can be checked). Unlike node-to-segment
-with a polyline, g is a smooth function of the nodal positions: at the start every slave sits
-exactly on a master node, where the normal of a polyline jumps and Newton cycles.
+    g_a = n · (x_s − x_a) = (x_{a+1} − x_{a−1}) × (x_s − x_a) / |x_{a+1} − x_{a−1}|.
+
+**Following the sliding.** At every evaluation each slave is projected afresh: its segment
+(a, b = a + 1) of the deformed chain is the one next to its nearest master node that holds its
+projection, at the parameter ξ = (x_s − x_a)·(x_b − x_a)/|x_b − x_a|² ∈ [0, 1]. Its gap blends
+the tangent lines of the segment's two nodes,
+
+    g = (1 − φ(ξ)) g_a + φ(ξ) g_b,   φ(ξ) = 3ξ² − 2ξ³  (clamped to 0 / 1 outside [0, 1]),
+
+a C¹ function of the positions of the five nodes (s, a − 1, a, b, b + 1): φ and φ' are 0 at ξ = 0
+and 1, φ' = 0 at ξ = 1, so where a slave passes a master node onto the next segment the gap and
+its gradient are those of that node's tangent line from both sides. This is a smoothed
+node-to-segment formulation: on a straight lip g is the exact distance; on a lip of curvature κ
+with master nodes Δ apart it is within κΔ²/8 of it (to leading order: the tangent lines' distance
+from the arc at mid-segment). A polyline's normal jumps at every master
+node, and at the start every corner slave sits exactly on one (Newton cycles there); the
+quadratic edges of the lips are only C⁰ at their corners for the same reason. In the reference
+state every slave lies on its coincident master node (ξ = 0), where g is that node's tangent-line
+gap. The sliding reported is the material distance of the master point the slave faces from the
+slave's own reference position, along the chain.
 
 The contact energy of a node is Π = ½ k b w_s ⟨−g⟩² (k penalty in N/mm³, b the width, w_s the
 slave's tributary length), so its force ∂Π/∂X and tangent ∂²Π/∂X² are exact derivatives of one
-scalar: the tangent is consistent and symmetric. Pressure p = k ⟨−g⟩ (MPa).
+scalar: the tangent is consistent and symmetric (up to the jump of ∂²g where ξ crosses 0 or 1).
+Pressure p = k ⟨−g⟩ (MPa).
+
+**The matrix pattern.** Each slave has a window of master chain nodes, [lo, hi], whose couplings
+the system's sparse matrix holds (:attr:`ContactPair.window`, initially :data:`WINDOW` nodes on
+either side of the coincident node). A slave in contact whose five nodes leave its window is
+reported (:attr:`ContactState.outside`); the system then widens the window and rebuilds its
+matrix (:meth:`ContactPair.widen`).
 """
 
 from __future__ import annotations
@@ -25,6 +46,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 J = np.array([[0.0, -1.0], [1.0, 0.0]])  # rotation by +90°
 # X = (x_s, x_0, x_1, x_2) stacked (8,); d = x_s − x_0 and a = x_2 − x_1 as linear maps of X
@@ -32,6 +54,19 @@ _Z = np.zeros((2, 2))
 _I = np.eye(2)
 _D = np.hstack([_I, -_I, _Z, _Z])
 _A = np.hstack([_Z, _Z, -_I, _I])
+
+#: Master chain nodes on either side of a slave's coincident node that the matrix pattern holds
+#: from the start (a chain node every half element: four quadratic edges each way).
+WINDOW = 8
+
+# the five nodes of a slave's gap, (s, p, a, b, q) = (slave, a − 1, a, b = a + 1, b + 1), as
+# DOF positions 0..9; where the tangent lines' (x_s, x_0, x_1, x_2) of gaps_with_derivatives sit
+_NODE_DOFS = np.arange(10).reshape(5, 2)
+_AT_A = _NODE_DOFS[[0, 2, 1, 3]].ravel()  # g_a: x_0 = a, chord p → b
+_AT_B = _NODE_DOFS[[0, 3, 2, 4]].ravel()  # g_b: x_0 = b, chord a → q
+_XI = _NODE_DOFS[[0, 2, 3]].ravel()  # ξ: (x_s, x_a, x_b)
+# ξ as a function of d = x_s − x_a and e = x_b − x_a: (d, e) = _M (x_s, x_a, x_b)
+_M = np.block([[_I, -_I, _Z], [_Z, -_I, _I]])
 
 
 def gap_with_derivatives(xs, x0, x1, x2):
@@ -77,51 +112,143 @@ def gaps_with_derivatives(d: np.ndarray, a: np.ndarray):
     return g, grad, 0.5 * (hess + hess.transpose(0, 2, 1))
 
 
+def segment_parameter(d: np.ndarray, e: np.ndarray):
+    """ξ = d·e/|e|² of slaves on segments (d = x_s − x_a, e = x_b − x_a, both (n, 2)).
+
+    Returns ξ (n,), its gradient (n, 6) and Hessian (n, 6, 6) with respect to (x_s, x_a, x_b).
+    """
+    L2 = np.einsum("ni,ni->n", e, e)
+    xi = np.einsum("ni,ni->n", d, e) / L2
+    xi_d = e / L2[:, None]
+    r = d - xi[:, None] * 2.0 * e  # ∂ξ/∂e = (d − 2ξ e)/|e|²
+    xi_e = r / L2[:, None]
+    H_de = np.eye(2)[None] / L2[:, None, None] - 2.0 * np.einsum("ni,nj->nij", e, e) / (
+        L2 * L2)[:, None, None]
+    er = np.einsum("ni,nj->nij", e, r)
+    H_ee = (-2.0 * (er + er.transpose(0, 2, 1)) / (L2 * L2)[:, None, None]
+            - (2.0 * xi / L2)[:, None, None] * np.eye(2)[None])
+    H = np.zeros((len(xi), 4, 4))
+    H[:, :2, 2:] = H_de
+    H[:, 2:, :2] = H_de
+    H[:, 2:, 2:] = H_ee
+    grad = np.concatenate([xi_d, xi_e], axis=1) @ _M
+    return xi, grad, np.einsum("ia,nij,jb->nab", _M, H, _M)
+
+
+def blend(xi: np.ndarray):
+    """φ(ξ) = 3ξ² − 2ξ³ on [0, 1], 0 below, 1 above; with φ' and φ''."""
+    t = np.clip(xi, 0.0, 1.0)
+    inside = (xi > 0.0) & (xi < 1.0)
+    return (t * t * (3.0 - 2.0 * t), np.where(inside, 6.0 * t * (1.0 - t), 0.0),
+            np.where(inside, 6.0 - 12.0 * t, 0.0))
+
+
+def blended_gaps(d_a, chord_a, d_b, chord_b, d, e, want_hessian: bool = True):
+    """Gaps g = (1 − φ(ξ)) g_a + φ(ξ) g_b of slaves on segments (a, b), with derivatives.
+
+    All arguments are (n, 2): ``d_a`` = x_s − x_a and ``chord_a`` = x_b − x_p (the tangent line
+    at a), ``d_b`` = x_s − x_b and ``chord_b`` = x_q − x_a (at b), ``d`` = x_s − x_a and
+    ``e`` = x_b − x_a (the segment). Returns g (n,), ξ (n,), the gradient (n, 10) and the Hessian
+    (n, 10, 10) (None unless asked for) with respect to the positions of (s, p, a, b, q).
+    """
+    n = len(d)
+    g_a, G_a, H_a = gaps_with_derivatives(d_a, chord_a)
+    g_b, G_b, H_b = gaps_with_derivatives(d_b, chord_b)
+    xi, X1, X2 = segment_parameter(d, e)
+    phi, dphi, d2phi = blend(xi)
+    delta = g_b - g_a
+    g = g_a + phi * delta
+    grad_a, grad_b, grad_xi = (np.zeros((n, 10)) for _ in range(3))
+    grad_a[:, _AT_A] = G_a
+    grad_b[:, _AT_B] = G_b
+    grad_xi[:, _XI] = X1
+    grad_delta = grad_b - grad_a
+    grad = grad_a + phi[:, None] * grad_delta + (dphi * delta)[:, None] * grad_xi
+    if not want_hessian:
+        return g, xi, grad, None
+    hess_a, hess_b, hess_xi = (np.zeros((n, 10, 10)) for _ in range(3))
+    hess_a[:, _AT_A[:, None], _AT_A[None, :]] = H_a
+    hess_b[:, _AT_B[:, None], _AT_B[None, :]] = H_b
+    hess_xi[:, _XI[:, None], _XI[None, :]] = X2
+    cross = np.einsum("ni,nj->nij", grad_delta, grad_xi)
+    hess = (hess_a + phi[:, None, None] * (hess_b - hess_a)
+            + dphi[:, None, None] * (cross + cross.transpose(0, 2, 1))
+            + (d2phi * delta)[:, None, None] * np.einsum("ni,nj->nij", grad_xi, grad_xi)
+            + (dphi * delta)[:, None, None] * hess_xi)
+    return g, xi, grad, hess
+
+
 @dataclass
 class ContactPair:
     """One debond's lips: node indices (into the arrays handed to :func:`evaluate`) and weights.
 
     :func:`sandwich.plane2d.model.contact_pairs` gives input-mesh node indices (the same on every
-    MPI
-    rank); the system renumbers them into its list of contact nodes.
+    MPI rank); the system renumbers them into its list of contact nodes.
     """
 
     slave: np.ndarray  # (ns,) face-lip nodes
-    anchor: np.ndarray  # (ns,) the coincident core-lip node of each slave
-    chord: np.ndarray  # (ns, 2) core-lip neighbours (x_1, x_2) of each anchor, n out of the core
+    master: np.ndarray  # (m,) the core-lip chain, ordered so that n points out of the core
+    anchor: np.ndarray  # (ns,) chain position of each slave's coincident core-lip node
     weight: np.ndarray  # (ns,) tributary length of each slave node (mm)
     penalty: float  # k (N/mm³)
     width: float  # b (mm)
     x_ref: np.ndarray  # (ns,) reference x of the slave nodes (for profiles)
+    window: np.ndarray | None = None  # (ns, 2) chain positions [lo, hi] the matrix holds
+
+    def __post_init__(self):
+        """The initial windows: :data:`WINDOW` chain nodes either side of the anchor."""
+        if len(self.master) < 2:
+            raise ValueError("a debond's core lip needs at least two nodes")
+        if self.window is None:
+            last = len(self.master) - 1
+            self.window = np.column_stack([np.clip(self.anchor - WINDOW, 0, last),
+                                           np.clip(self.anchor + WINDOW, 0, last)])
 
     @property
-    def all_blocks(self) -> np.ndarray:
-        """(ns, 4): the nodes (s, 0, 1, 2) each slave's gap depends on."""
-        return np.column_stack([self.slave, self.anchor, self.chord[:, 0], self.chord[:, 1]])
+    def nodes(self) -> np.ndarray:
+        """Every node the pair's gaps may depend on (slaves, then the master chain)."""
+        return np.concatenate([self.slave, self.master])
 
-    def blocks(self, i: int) -> np.ndarray:
-        """The four nodes (s, 0, 1, 2) slave i's gap depends on."""
-        return self.all_blocks[i]
+    def window_nodes(self, i: int) -> np.ndarray:
+        """Slave i and the master nodes of its window (the couplings the matrix holds for it)."""
+        lo, hi = self.window[i]
+        return np.concatenate([[self.slave[i]], self.master[lo: hi + 1]])
+
+    def widen(self, slaves: np.ndarray, spans: np.ndarray) -> None:
+        """Widen the windows of ``slaves`` to hold their chain ``spans`` (k, 2), with room to spare.
+
+        A window is widened by half of :data:`WINDOW` beyond what the span needs, so that a slave
+        sliding on does not widen it at every step.
+        """
+        last = len(self.master) - 1
+        lo = np.clip(spans[:, 0] - WINDOW // 2, 0, last)
+        hi = np.clip(spans[:, 1] + WINDOW // 2, 0, last)
+        self.window[slaves, 0] = np.minimum(self.window[slaves, 0], lo)
+        self.window[slaves, 1] = np.maximum(self.window[slaves, 1], hi)
 
     def renumbered(self, index: dict[int, int]) -> ContactPair:
-        """The same pair with every node n replaced by ``index[n]``."""
+        """The same pair with every node n replaced by ``index[n]`` (the windows shared)."""
         def m(a):
             return np.vectorize(lambda k: index[int(k)], otypes=[np.int64])(a)
-        return ContactPair(m(self.slave), m(self.anchor), m(self.chord), self.weight,
-                           self.penalty, self.width, self.x_ref)
+        return ContactPair(m(self.slave), m(self.master), self.anchor, self.weight,
+                           self.penalty, self.width, self.x_ref, self.window)
 
 
 @dataclass
 class ContactState:
-    """Result of one contact evaluation (arrays over the active slaves, in slave order)."""
+    """Result of one contact evaluation (arrays over the slaves, or the active ones, in order)."""
 
     gap: np.ndarray  # (ns,) signed gaps (mm), negative = penetration
-    slip: np.ndarray  # (ns,) tangential offset of the slave from its anchor (mm)
+    slip: np.ndarray  # (ns,) sliding: the master point faced, from the slave's own (mm)
     pressure: np.ndarray  # (ns,) p = k ⟨−g⟩ (MPa)
+    segment: np.ndarray  # (ns,) chain position a of each slave's segment (a, a + 1)
+    xi: np.ndarray  # (ns,) its parameter ξ on the segment
     active: np.ndarray  # (na,) indices of the slaves with g <= 0
-    rows: np.ndarray  # (na, 4) their nodes (s, 0, 1, 2)
-    forces: np.ndarray  # (na, 8) ∂Π/∂X
-    tangents: np.ndarray | None  # (na, 8, 8) ∂²Π/∂X² (None unless asked for)
+    rows: np.ndarray  # (na, 5) their nodes (s, a − 1, a, a + 1, a + 2)
+    forces: np.ndarray  # (na, 10) ∂Π/∂X
+    tangents: np.ndarray | None  # (na, 10, 10) ∂²Π/∂X² (None unless asked for)
+    outside: np.ndarray  # (no,) active slaves whose five nodes leave their window
+    spans: np.ndarray  # (no, 2) the chain positions (a − 1, a + 2) they need
 
     def nodal_forces(self, n_nodes: int) -> np.ndarray:
         """The forces summed per node, (n_nodes, 2)."""
@@ -134,29 +261,48 @@ def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
              want_tangent: bool = True) -> ContactState:
     """Gaps, pressures, forces and tangents at reference positions + displacements (nodes, 2).
 
-    Vectorised over the slaves of the pair. The slave–anchor offset x_s − x_0 is formed as
-    (X_s − X_0) + (u_s − u_0): the positions are ~10² mm while the gap is ~10⁻⁵ mm, and X + u
-    first would lose the gap to round-off (which the stiff penalty turns into a residual floor
-    far above Newton's tolerance).
+    Vectorised over the slaves of the pair. Each slave's segment is found afresh (module
+    docstring). Every offset x_i − x_j is formed as (X_i − X_j) + (u_i − u_j): the positions are
+    ~10² mm while the gap is ~10⁻⁵ mm, and X + u first would lose the gap to round-off (which the
+    stiff penalty turns into a residual floor far above Newton's tolerance).
     """
-    s, a0 = pair.slave, pair.anchor
-    c1, c2 = pair.chord[:, 0], pair.chord[:, 1]
-    d = (x_ref[s] - x_ref[a0]) + (u[s] - u[a0])
-    chord = (x_ref[c2] + u[c2]) - (x_ref[c1] + u[c1])
-    L = np.sqrt(np.einsum("ni,ni->n", chord, chord))
-    slips = np.einsum("ni,ni->n", d, chord) / L
-    gaps = np.einsum("ni,ni->n", (chord @ J.T) / L[:, None], d)  # as in gaps_with_derivatives
+    s, m = pair.slave, pair.master
+    last = len(m) - 1
+
+    def offset(i, j):
+        return (x_ref[i] - x_ref[j]) + (u[i] - u[j])
+
+    nearest = cKDTree(x_ref[m] + u[m]).query(x_ref[s] + u[s])[1]
+    a = np.minimum(nearest, last - 1)
+    e = offset(m[a + 1], m[a])
+    ahead = np.einsum("ni,ni->n", offset(s, m[a]), e) / np.einsum("ni,ni->n", e, e)
+    a = np.where((ahead < 0.0) & (a == nearest) & (a > 0), a - 1, a)  # the segment behind
+    b = a + 1
+    p, q = np.maximum(a - 1, 0), np.minimum(b + 1, last)
+    d = offset(s, m[a])
+    g, xi, grad, hess = blended_gaps(d, offset(m[b], m[p]), offset(s, m[b]), offset(m[q], m[a]),
+                                     d, offset(m[b], m[a]), want_hessian=want_tangent)
     # g = 0 counts as active (force 0, tangent k b w ∇g ∇gᵀ, a valid choice at the kink of
     # ⟨−g⟩²): lips that touch in the reference state start supported instead of free
-    active = np.flatnonzero(gaps <= 0.0)
-    g, dg, d2g = gaps_with_derivatives(d[active], chord[active])
+    active = np.flatnonzero(g <= 0.0)
     kw = pair.penalty * pair.width * pair.weight[active]
-    forces = (kw * g)[:, None] * dg
+    ga, grad_a = g[active], grad[active]
+    forces = (kw * ga)[:, None] * grad_a
     tangents = None
     if want_tangent:
-        tangents = kw[:, None, None] * (np.einsum("na,nb->nab", dg, dg) + g[:, None, None] * d2g)
-    pressure = pair.penalty * np.maximum(-gaps, 0.0)
-    return ContactState(gaps, slips, pressure, active, pair.all_blocks[active], forces, tangents)
+        tangents = kw[:, None, None] * (np.einsum("na,nb->nab", grad_a, grad_a)
+                                        + ga[:, None, None] * hess[active])
+    t = x_ref[m[-1]] - x_ref[m[0]]
+    t = t / np.linalg.norm(t)
+    faced = x_ref[m[a]] + np.clip(xi, 0.0, 1.0)[:, None] * (x_ref[m[b]] - x_ref[m[a]])
+    slip = (faced - x_ref[s]) @ t
+    pressure = pair.penalty * np.maximum(-g, 0.0)
+    rows = np.column_stack([s, m[p], m[a], m[b], m[q]])[active]
+    lo, hi = pair.window[active, 0], pair.window[active, 1]
+    out = (p[active] < lo) | (q[active] > hi)
+    outside = active[out]
+    return ContactState(g, slip, pressure, a, xi, active, rows, forces, tangents, outside,
+                        np.column_stack([p, q])[outside])
 
 
 def slave_weights(x_ref: np.ndarray, x_left_tip: float | None,

@@ -246,7 +246,7 @@ def probe_vector(V, x: float, band: LayerBand, n_local: int) -> np.ndarray:
 
 def contact_pairs(scene: Scene, mesh, disc: Discretisation,
                   penalty: float) -> tuple[list[ct.ContactPair], list[str]]:
-    """Node-to-segment contact data of every debond that has lip nodes."""
+    """Finite-sliding contact data (:mod:`sandwich.plane2d.contact`) of every debond with lips."""
     pairs, ifaces = [], []
     lip_pairs = getattr(mesh, "lip_pairs", {}) or {}
     pts = np.asarray(mesh.points)[:, :2]
@@ -273,15 +273,11 @@ def contact_pairs(scene: Scene, mesh, disc: Discretisation,
         master = np.array(chain, dtype=np.int64)
         slave = np.asarray(face_nodes, dtype=np.int64)
         position = {int(blk): k for k, blk in enumerate(master)}
-        anchor = np.asarray(core_nodes, dtype=np.int64)
-        chord = np.zeros((len(slave), 2), dtype=np.int64)
-        for j, blk in enumerate(anchor):
-            k = position[int(blk)]
-            chord[j] = (master[max(k - 1, 0)], master[min(k + 1, len(master) - 1)])
+        anchor = np.array([position[int(n)] for n in core_nodes], dtype=np.int64)
         x_face = pts[face_nodes, 0]
         # a missing tip is an open mouth (debond reaching the beam end): no bonded corner there
         x_tips = [None if t is None else float(pts[t, 0]) for t in tips]
         weight = ct.slave_weights(x_face, x_tips[0], x_tips[1])  # start < end (scene checks)
-        pairs.append(ct.ContactPair(slave, anchor, chord, weight, penalty, scene.width, x_face))
+        pairs.append(ct.ContactPair(slave, master, anchor, weight, penalty, scene.width, x_face))
         ifaces.append(debond.interface)
     return pairs, ifaces

@@ -83,6 +83,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         core_states.append((int(state.step), float(state.load_factor), core))
         extra = {"max_penetration": contact["max_penetration"],
                  "max_contact_pressure": contact["max_contact_pressure"],
+                 "max_sliding": contact["max_sliding"],
                  "core_min_stretch": core.min_stretch,
                  "core_ellipticity": core.ellipticity,
                  "cuts": float(state.cuts)}
@@ -130,6 +131,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
         "refine": int(getattr(mesh, "refine", refine or 0)),
         "contact_penalty": model.penalty,
         "max_penetration": float(penetration),
+        "max_sliding": float(max((r.extra["max_sliding"] for r in rows), default=0.0)),
         "max_penetration_over_face_thickness": float(
             penetration / min(scene.top.thickness, scene.bottom.thickness)),
         "newton_iterations": int(sum(r.iterations for r in rows)),

@@ -4,7 +4,9 @@ Unknowns are all displacement DOFs of the vector Q2 space (x then z component pe
 block order). Supports are homogeneous and imposed as trivial equations u_i = 0 (row and column
 of the tangent replaced by the identity), so the constrained DOFs stay zero along any path and
 the solver's vectors need no index juggling. Contact terms are evaluated in NumPy and added to the
-PETSc matrix, whose sparsity pattern holds every potential contact block from the start.
+PETSc matrix, whose sparsity pattern holds each slave's couplings with a window of master nodes
+around it; a slave in contact that slides out of its window widens it, and the matrix is rebuilt
+(and MUMPS analyses it afresh).
 
 MPI: numpy vectors are the rank's owned DOFs. The two lips of a debond share no cell, so a
 slave's anchor and chord nodes are often on another rank: the displacements of all contact nodes
@@ -168,7 +170,7 @@ class Reference2DSystem(ResidualRoundoff):
         self.last_contact: list[ct.ContactState] = []  # of the committed state
         self._evaluated_contact: list[ct.ContactState] = []  # of the last internal_force
         self.counters = {"residuals": 0, "tangents": 0, "factorizations": 0,
-                         "refactorizations": 0}
+                         "refactorizations": 0, "pattern_growths": 0}
         self._mumps = MumpsSolver(self.comm)
         self._rhs, self._sol = self.A.createVecs()
         self._generation = 0
@@ -225,6 +227,9 @@ class Reference2DSystem(ResidualRoundoff):
     def tangent(self, u: np.ndarray) -> PETSc.Mat:
         """K = ∂(f_int + f_contact)/∂u from ``ufl.derivative`` plus the contact Hessian."""
         self._set_u(u)
+        states = self._contact_states(want_tangent=True)
+        if any(len(state.outside) for state, _pair in states):
+            self._widen_windows(states)
         A = self.A
         A.zeroEntries()
         fem_petsc.assemble_matrix(A, self.J_form)
@@ -232,12 +237,11 @@ class Reference2DSystem(ResidualRoundoff):
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
         if self._c_nnz:
             # every contact slot of the pattern (zeros where open), summed over the active
-            # slaves' 8×8 blocks with one bincount, inserted row by row (owned rows only)
+            # slaves' 10×10 blocks with one bincount, inserted row by row (owned rows only)
             data = np.zeros(self._c_nnz)
-            for state, pair in self._contact_states(want_tangent=True):
-                slots = self._c_slots[id(pair)][state.active]
-                data += np.bincount(slots.ravel(), weights=state.tangents.ravel(),
-                                    minlength=self._c_nnz)
+            for state, _pair in states:
+                slots = self._contact_slots(state.rows)
+                data += np.bincount(slots, weights=state.tangents.ravel(), minlength=self._c_nnz)
             add = PETSc.InsertMode.ADD_VALUES
             for row, lo, hi in self._c_rows:
                 A.setValues(row, self._c_cols[lo:hi], data[lo:hi], addv=add)
@@ -309,11 +313,11 @@ class Reference2DSystem(ResidualRoundoff):
         """The contact nodes (input indices) as a compact list, the same on every rank.
 
         Their global DOF blocks and reference positions, the owned ones' local blocks, and the
-        tangent's slot map (each entry of each slave's 8×8 block -> slot of the contact CSR).
+        contact part of the matrix pattern (:meth:`_contact_pattern`).
         """
         im = self.V.dofmap.index_map
         pairs = self.contacts
-        nodes = (np.unique(np.concatenate([p.all_blocks.ravel() for p in pairs]))
+        nodes = (np.unique(np.concatenate([p.nodes for p in pairs]))
                  if pairs else np.zeros(0, dtype=np.int64))
         self._nc = nc = len(nodes)
         index = {int(n): k for k, n in enumerate(nodes)}
@@ -334,28 +338,56 @@ class Reference2DSystem(ResidualRoundoff):
             xref = allreduce_array(self.comm, xref, MPI.SUM)
         if np.any(gblock < 0):
             raise ValueError("a contact node is owned by no rank")
-        self._c_gblock, self._c_xref = gblock, xref
-        # the contact part of the pattern in compact DOFs (2 node + component): for each pair
-        # the slot of every entry of every slave's 8×8 block in one sorted list of (row, col)
-        keys, sizes = [], []
-        for p in pairs:
-            dofs = (2 * self._compact[id(p)].all_blocks[:, :, None] + np.arange(2)).reshape(-1, 8)
-            keys.append((dofs[:, :, None] * (2 * nc) + dofs[:, None, :]).ravel())
-            sizes.append(len(dofs))
-        uniq, inverse = (np.unique(np.concatenate(keys), return_inverse=True) if keys
-                         else (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
-        self._c_nnz = len(uniq)
-        self._c_slots, start = {}, 0
-        for p, n in zip(pairs, sizes, strict=True):
-            self._c_slots[id(p)] = inverse[start: start + 64 * n].reshape(n, 8, 8)
-            start += 64 * n
-        rows, cols = uniq // (2 * nc) if nc else uniq, uniq % (2 * nc) if nc else uniq
+        self._c_gblock, self._c_xref, self._c_owned = gblock, xref, owned
+        self._contact_pattern()
+
+    def _contact_pattern(self) -> None:
+        """The contact part of the matrix pattern, in compact DOFs (2 node + component).
+
+        Each slave couples with every master node of its window (and those with each other):
+        one sorted list of keys row · 2n_c + column, the global column of each and, per owned
+        row, its range in the list.
+        """
+        nc, gblock = self._nc, self._c_gblock
+        keys = []
+        for p in self._compact.values():
+            for i in range(len(p.slave)):
+                dofs = (2 * p.window_nodes(i)[:, None] + np.arange(2)).ravel()
+                keys.append((dofs[:, None] * (2 * nc) + dofs[None, :]).ravel())
+        uniq = np.unique(np.concatenate(keys)) if keys else np.zeros(0, dtype=np.int64)
+        self._c_keys, self._c_nnz = uniq, len(uniq)
+        rows, cols = (uniq // (2 * nc), uniq % (2 * nc)) if nc else (uniq, uniq)
         self._c_pattern_nodes = (rows // 2, cols // 2)  # compact node pairs, for the matrix
         self._c_cols = (2 * gblock[cols // 2] + cols % 2).astype(np.int32)  # global columns
         bounds = np.flatnonzero(np.diff(rows, prepend=-1, append=-1))
         self._c_rows = [(int(2 * gblock[rows[lo] // 2] + rows[lo] % 2), int(lo), int(hi))
                         for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
-                        if owned[rows[lo] // 2]]
+                        if self._c_owned[rows[lo] // 2]]
+
+    def _contact_slots(self, rows: np.ndarray) -> np.ndarray:
+        """Contact-pattern slots of every entry of the (k, 5)-node blocks ``rows``, raveled."""
+        dofs = (2 * rows[:, :, None] + np.arange(2)).reshape(len(rows), 2 * rows.shape[1])
+        keys = (dofs[:, :, None] * (2 * self._nc) + dofs[:, None, :]).ravel()
+        slots = np.searchsorted(self._c_keys, keys)
+        if len(keys) and (slots.max() >= self._c_nnz
+                          or not np.array_equal(self._c_keys[slots], keys)):
+            raise RuntimeError("a contact block outside the matrix pattern")
+        return slots
+
+    def _widen_windows(self, states) -> None:
+        """Widen the windows slaves in contact slid out of; rebuild the matrix with them.
+
+        Every rank evaluates the same contact, so every rank rebuilds. MUMPS analyses the new
+        pattern at the next factorisation.
+        """
+        for state, pair in states:
+            if len(state.outside):
+                self._compact[id(pair)].widen(state.outside, state.spans)
+        self._contact_pattern()
+        self.A.destroy()
+        self.A = self._create_matrix()
+        self._mumps.reset()
+        self.counters["pattern_growths"] += 1
 
     def _contact_states(self, want_tangent: bool):
         """[(state, pair)] of every pair, from the contact-node displacements of all ranks."""
@@ -426,7 +458,12 @@ class Reference2DSystem(ResidualRoundoff):
         return float(np.sqrt(self.dot(a, a)))
 
     def contact_summary(self) -> dict[str, float]:
-        """Max penetration (mm) and max pressure (MPa) of the last committed state."""
+        """Max penetration (mm), pressure (MPa) and sliding of the lips in contact (mm).
+
+        Of the last committed state; the sliding is the largest |slip| of a slave in contact.
+        """
         pen = max((float(np.max(-s.gap, initial=0.0)) for s in self.last_contact), default=0.0)
         p = max((float(np.max(s.pressure, initial=0.0)) for s in self.last_contact), default=0.0)
-        return {"max_penetration": max(pen, 0.0), "max_contact_pressure": p}
+        slide = max((float(np.max(np.abs(s.slip[s.active]), initial=0.0))
+                     for s in self.last_contact), default=0.0)
+        return {"max_penetration": max(pen, 0.0), "max_contact_pressure": p, "max_sliding": slide}
