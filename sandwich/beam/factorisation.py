@@ -42,7 +42,11 @@ class TangentFactorisations:
     The symbolic part (ordering, envelope of the values) is computed once per structure and
     kept (:attr:`structures`, at most :data:`KEPT_STRUCTURES`), widened when a tangent has a
     coupling outside it. The structures belong to one pattern: a matrix factorised for another
-    (the compiled path's pattern grew) starts them afresh.
+    (the compiled path's pattern grew) starts them afresh. A structure dropped (replaced by its
+    widening, pushed out, or of the old pattern) is retired
+    (:meth:`~sandwich.solver.envelope.EnvelopeStructure.retire`): the factorisations still alive
+    on it (the path's last states', the corrector's) keep only what they solve with, not maps
+    of the pattern's size each.
     """
 
     def __init__(self) -> None:
@@ -56,6 +60,7 @@ class TangentFactorisations:
         except ImportError:  # no numba
             return SparseFactorization(K)
         if pattern is not self._pattern:
+            _retire(self.structures)
             self.structures, self._pattern = [], pattern
         K = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
         known = self.structures
@@ -70,10 +75,18 @@ class TangentFactorisations:
             # and open pairs are zero; a matrix with a coupling outside it widens it
             structure = EnvelopeStructure.of(K, numeric=True)
             known.insert(1 if known else 0, structure)  # keep the model's own pattern's
+            _retire(known[KEPT_STRUCTURES:])
             del known[KEPT_STRUCTURES:]
         fac = factorize_envelope(K, structure)
         widened = getattr(fac, "structure", structure)
         if (widened is not structure and widened.matches(K)
                 and widened is not structure.kept_natural):  # not the natural-order retry's
             known[known.index(structure)] = widened
+            structure.retire()
         return fac
+
+
+def _retire(structures: list) -> None:
+    """Retire the envelope structures no longer kept (their factorisations still solve)."""
+    for structure in structures:
+        structure.retire()

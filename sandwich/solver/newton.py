@@ -221,6 +221,9 @@ def newton_correct(
         return NewtonResult(False, u0.copy(), lam0, its, r_norm, reason)
 
     trial_force = None  # f_int at the iterate, when the line search has evaluated it
+    # the last iterate's factorisation: let go before the next is made, so that two of them
+    # (a factor each, the size of the tangent's envelope) are never held at once
+    fac = None
     nearby = getattr(system, "internal_force_nearby", None)
     limit = getattr(system, "correction_limit", None) if settings.limit_corrections else None
     small_step = False  # the last correction passed the increment test
@@ -266,6 +269,7 @@ def newton_correct(
                     if r_norm <= floor:
                         how = "converged to the round-off floor"
                 if how:
+                    fac = None
                     try:
                         fac = system.factorize(system.tangent(u))
                     except RECOVERABLE_ERRORS as exc:
@@ -287,6 +291,7 @@ def newton_correct(
                     it < settings.max_iterations + extra
                     and it - changed_at <= SETTLED_ITERATIONS):
                 break
+            fac = None
             try:
                 fac = system.factorize(system.tangent(u))
                 du_r, du_f = _solve_both(fac, -res, f_ref)

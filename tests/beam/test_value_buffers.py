@@ -49,3 +49,27 @@ def test_a_released_array_is_reused_and_starts_from_zero(states):
     assert K.data.base.ctypes.data in before  # an array of the list, not a new one
     fresh = build_model(scene, elements=40, core_level=2).tangent(us[0] * 0.9)
     assert np.array_equal(K.toarray(), fresh.toarray())
+
+
+def test_the_factorisations_keep_one_structure_and_retire_those_they_drop(states):
+    """A structure the model's factorisations drop (widened, of a pattern that grew) is retired
+    (its pattern-sized maps go, EnvelopeStructure.retire); a factorisation made on it still
+    solves, bit for bit; the model keeps the structures of its present pattern only."""
+    from sandwich.solver.envelope import EnvelopeFactorization
+
+    scene, _, us = states
+    model = build_model(scene, elements=40, core_level=2)  # its pattern grows below
+    assert model.pairs[-1].search == "closest-point"
+    fac = model.factorize(model.tangent(us[2]))
+    assert isinstance(fac, EnvelopeFactorization)
+    first = fac.structure
+    b = np.arange(model.size, dtype=float)
+    x = fac.solve(b)
+    old = model.factorisations.structures
+    assert first in old and first.indices is not None
+    model.compiled.grow(model.block_dofs[-1][:1, :10])  # the pattern grows: a new one
+    fac2 = model.factorize(model.tangent(us[2]))
+    assert fac2.structure is not first and first.indices is None  # retired with its pattern
+    assert all(s.indices is not None for s in model.factorisations.structures)
+    assert np.array_equal(fac.solve(b), x)
+    assert np.allclose(fac2.solve(b), x, rtol=1e-9, atol=1e-9 * np.abs(x).max())

@@ -616,3 +616,29 @@ def test_a_structure_matches_its_pattern_through_new_views_and_copies_only():
     assert not s.matches(other)
     assert not same_memory(s.indices[:-1], s.indices)
     assert not same_memory(s.indices[::2], s.indices[:s.indices.size // 2 + 1])
+
+
+def test_a_retired_structure_keeps_what_its_factorisations_solve_with_only():
+    """``EnvelopeStructure.retire``: a factorisation made on the structure solves as before
+    (bit for bit); the pattern-sized maps, the pattern, its spares and its natural-order
+    variant are gone; the structure matches nothing, so a matrix of its pattern gets a new
+    one, with the same answer."""
+    rng = np.random.default_rng(5)
+    n = 80
+    A = _variable_band(rng, n, rng.integers(0, 12, size=n))
+    A.sort_indices()
+    s = EnvelopeStructure.of(A, numeric=True)
+    natural = s.natural_variant(A)
+    fac = factorize_envelope(A, s)
+    b = rng.normal(size=n)
+    x = fac.solve(b)
+    assert s.matches(A) and s.spare_addresses
+    s.retire()
+    assert np.array_equal(fac.solve(b), x)
+    assert all(getattr(s, name) is None for name in (
+        "slots", "positions", "indptr", "indices", "values_indptr", "values_indices"))
+    assert not s.spare_addresses and s.kept_natural is None and natural.indices is None
+    assert not s.matches(A) and s.size == fac.factors.size and s.flops > 0
+    again = factorize_envelope(A, s)
+    assert again.structure is not s and again.structure.matches(A)
+    assert np.array_equal(again.solve(b), x)

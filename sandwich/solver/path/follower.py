@@ -123,6 +123,7 @@ class PathFollower(RescueSteps, CriticalPoints, StepSizeControl, SystemSwitch):
             if (self.rescues and self.rescues[-1] == step) or self.jumped(last, state, t):
                 self.walk_branch_left(state, last, t)
             self.locate_crossing(state, last, fac_before, fac, t)
+            fac_before = None  # not needed again: the next step's corrector makes its own
             switched = self.switch_system(state)
             if switched is not None:  # the state re-converged on a finer system replaces it
                 fac, t = switched
