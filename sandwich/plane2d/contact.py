@@ -37,8 +37,8 @@ Pressure p = k ⟨−g⟩ (MPa).
 **The matrix pattern.** Each slave has a window of master chain nodes, [lo, hi], whose couplings
 the system's sparse matrix holds (:attr:`ContactPair.window`, initially :data:`WINDOW` nodes on
 either side of the coincident node). A slave in contact whose five nodes leave its window is
-reported (:attr:`ContactState.outside`); the system then widens the window and rebuilds its
-matrix (:meth:`ContactPair.widen`).
+reported (:attr:`ContactState.outside`); the system then widens the windows crowded at that
+moment and rebuilds its matrix (:meth:`ContactPair.widen`).
 """
 
 from __future__ import annotations
@@ -214,17 +214,21 @@ class ContactPair:
         lo, hi = self.window[i]
         return np.concatenate([[self.slave[i]], self.master[lo: hi + 1]])
 
-    def widen(self, slaves: np.ndarray, spans: np.ndarray) -> None:
-        """Widen the windows of ``slaves`` to hold their chain ``spans`` (k, 2), with room to spare.
+    def widen(self, state: ContactState) -> None:
+        """Widen the windows of this pair's slaves in contact at or near their edges (``state``).
 
-        A window is widened by half of :data:`WINDOW` beyond what the span needs, so that a slave
-        sliding on does not widen it at every step.
+        Its ``outside`` slaves left their windows; the slaves in contact whose spans come within
+        ``WINDOW // 2`` nodes of an edge of theirs are widened with them (slaves near the one
+        that left slide alike). A window is widened on the side it is crowded to hold the span
+        and :data:`WINDOW` nodes beyond, so that sliding on does not widen it at every step.
         """
         last = len(self.master) - 1
-        lo = np.clip(spans[:, 0] - WINDOW // 2, 0, last)
-        hi = np.clip(spans[:, 1] + WINDOW // 2, 0, last)
-        self.window[slaves, 0] = np.minimum(self.window[slaves, 0], lo)
-        self.window[slaves, 1] = np.maximum(self.window[slaves, 1], hi)
+        act = state.active
+        lo, hi = self.window[act, 0], self.window[act, 1]
+        p, q = state.spans[act, 0], state.spans[act, 1]
+        low, high = p - lo < WINDOW // 2, hi - q < WINDOW // 2
+        self.window[act[low], 0] = np.clip(p[low] - WINDOW, 0, last)
+        self.window[act[high], 1] = np.clip(q[high] + WINDOW, 0, last)
 
     def renumbered(self, index: dict[int, int]) -> ContactPair:
         """The same pair with every node n replaced by ``index[n]`` (the windows shared)."""
@@ -247,8 +251,8 @@ class ContactState:
     rows: np.ndarray  # (na, 5) their nodes (s, a − 1, a, a + 1, a + 2)
     forces: np.ndarray  # (na, 10) ∂Π/∂X
     tangents: np.ndarray | None  # (na, 10, 10) ∂²Π/∂X² (None unless asked for)
+    spans: np.ndarray  # (ns, 2) the chain positions (a − 1, a + 2) of each slave's five nodes
     outside: np.ndarray  # (no,) active slaves whose five nodes leave their window
-    spans: np.ndarray  # (no, 2) the chain positions (a − 1, a + 2) they need
 
     def nodal_forces(self, n_nodes: int) -> np.ndarray:
         """The forces summed per node, (n_nodes, 2)."""
@@ -301,8 +305,8 @@ def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
     lo, hi = pair.window[active, 0], pair.window[active, 1]
     out = (p[active] < lo) | (q[active] > hi)
     outside = active[out]
-    return ContactState(g, slip, pressure, a, xi, active, rows, forces, tangents, outside,
-                        np.column_stack([p, q])[outside])
+    return ContactState(g, slip, pressure, a, xi, active, rows, forces, tangents,
+                        np.column_stack([p, q]), outside)
 
 
 def slave_weights(x_ref: np.ndarray, x_left_tip: float | None,

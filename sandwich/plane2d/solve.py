@@ -17,6 +17,7 @@ from sandwich.scene import Scene
 from sandwich.solver.path import PathOptions, PathState, follow_path, solve_linear
 
 MODEL_NAME = "2d"
+PENETRATION_BOUND = 1e-3  # penetration allowed, a fraction of the thinner face (docs/contact.md)
 
 
 def build_scene_mesh(scene: Scene, level: str | None = None, refine: int | None = None):
@@ -162,6 +163,11 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
             step, lf, core = core_states[crushed[0]]
             before = core_states[crushed[0] - 1][:2] if crushed[0] > 0 else None
             warnings.append(crushing_warning(core, step, lf, before))
+    bound = PENETRATION_BOUND * min(scene.top.thickness, scene.bottom.thickness)
+    if penetration > bound:
+        warnings.append(f"contact penetration {penetration:.3g} mm exceeds {bound:.3g} mm "
+                        f"({PENETRATION_BOUND:g} x the face thickness; raise "
+                        f"reference2d.contact_penalty, now {model.penalty:.4g} N/mm^3)")
     if newton_tol is not None:
         extra["newton_tol"] = float(newton_tol)
         extra["residual_roundoff_bound"] = float(roundoff)

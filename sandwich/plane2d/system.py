@@ -382,7 +382,7 @@ class Reference2DSystem(ResidualRoundoff):
         """
         for state, pair in states:
             if len(state.outside):
-                self._compact[id(pair)].widen(state.outside, state.spans)
+                self._compact[id(pair)].widen(state)
         self._contact_pattern()
         self.A.destroy()
         self.A = self._create_matrix()

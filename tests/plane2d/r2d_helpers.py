@@ -50,10 +50,13 @@ def strip_scene(debonds, E=100.0, nu=0.3, t_face=0.5, t_core=4.0, length=20.0, w
                  Analysis(kind="linear", until_load_factor=1.0))
 
 
-def pressed_strip(debonded: bool, pressure: float, nx=20, penalty=None, span=(5.0, 15.0)):
+def pressed_strip(debonded: bool, pressure: float, nx=20, penalty=None, span=(5.0, 15.0),
+                  empty_windows=False):
     """The strip on a frictionless floor (w = 0 on z = bottom, u = 0 at one bottom node), uniform
     pressure ``pressure`` (MPa, positive pushes down) on the whole top edge. Debond: top
-    interface, x in ``span`` (reaching x = 0 or 20: open mouth). Returns (system, pairs)."""
+    interface, x in ``span`` (reaching x = 0 or 20: open mouth). ``empty_windows``: every
+    slave's window starts as its coincident node alone, so that the first tangent widens them.
+    Returns (system, pairs)."""
     from sandwich.plane2d.model import contact_pairs, default_penalty, layer_bands
 
     scene = strip_scene([span] if debonded else [])
@@ -72,6 +75,8 @@ def pressed_strip(debonded: bool, pressure: float, nx=20, penalty=None, span=(5.
     f = edge_load_vector(V, facets, (0.0, -pressure), scene.width, n_local)
     k = penalty if penalty is not None else default_penalty(scene)
     pairs, _ = contact_pairs(scene, mesh, disc, k)
+    for p in pairs if empty_windows else ():
+        p.window[:] = p.anchor[:, None]
     from sandwich.plane2d.model import face_band
 
     probes = {"w_top_mid": probe_vector(V, 10.0, face_band(scene, "top"), n_local)}

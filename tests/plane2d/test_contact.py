@@ -114,3 +114,15 @@ def test_opening_open_mouth_debond_carries_no_pressure():
     print(f"gaps {state.gap.min():.4g}..{state.gap.max():.4g}")
     assert np.all(state.pressure == 0.0)
     assert np.all(state.gap >= 0.0) and state.gap.max() > 1e-3
+
+
+def test_windows_slid_out_of_are_widened_and_the_matrix_rebuilt_without_changing_the_answer():
+    # reference: the same strip with the default windows (no widening needed)
+    wide, _ = pressed_strip(True, PRESSURE)
+    narrow, _ = pressed_strip(True, PRESSURE, empty_windows=True)
+    uw, logs_w = _solve(wide, 1.0, steps=2)
+    un, logs_n = _solve(narrow, 1.0, steps=2)
+    assert wide.counters["pattern_growths"] == 0
+    assert narrow.counters["pattern_growths"] >= 1
+    assert [len(r) for r in logs_n] == [len(r) for r in logs_w]
+    assert np.allclose(un, uw, rtol=1e-9, atol=1e-12 * np.abs(uw).max())
