@@ -14,11 +14,16 @@ from sandwich.scene import Scene
 
 
 def segments_for(layout: Layout, sizing: Sizing) -> list[Segment]:
-    """The x segments of the mesh: graded between key stations, then subdivided."""
+    """The x segments of the mesh: graded between key stations, then subdivided.
+
+    Over a debond the elements are at most ``sizing.debond_size`` long, elsewhere
+    ``sizing.far_size``.
+    """
     segs: list[Segment] = []
     st, sharp = layout.stations, layout.sharp
     for a, b, sa, sb in zip(st, st[1:], sharp, sharp[1:], strict=False):
-        segs += grade_block(a, b, sa, sb, sizing.tip_size, sizing.far_size, sizing.growth)
+        far = sizing.debond_size if layout.debonded(a, b) else sizing.far_size
+        segs += grade_block(a, b, sa, sb, sizing.tip_size, far, sizing.growth)
     return [s.subdivided(sizing.subdivision) for s in segs]
 
 

@@ -50,6 +50,10 @@ class Layout:
     loads: tuple[tuple[int, float, float], ...]  # (scene index, lo, hi); lo == hi: point load
     probes: tuple[tuple[str, float], ...]  # (name, x); mirrored into the half for a half model
 
+    def debonded(self, a: float, b: float) -> bool:
+        """Whether [a, b] lies on a debond of either interface."""
+        return any(c.start - GEOM_TOL <= a and b <= c.end + GEOM_TOL for c in self.cracks)
+
     def is_open(self, crack: Crack, x: float) -> bool:
         """Whether the two lips of ``crack`` have separate corners at station x."""
         if crack.contains(x):

@@ -23,6 +23,11 @@ CORE_HALF_ELEMENTS = 4  # coarse: elements from an interface to the core mid-pla
 CORE_GROWTH = 1.5  # coarse: length ratio of neighbouring elements from interface to mid-plane
 FAR_PER_HEIGHT = 0.2  # coarse far-field element length as a fraction of the beam height
 MAX_FACE_ASPECT = 20.0  # coarse far-field element length / face element thickness, at most
+#: coarse element length / face element thickness, at most, over a debond: a debonded face bends
+#: on its own there (at a clamp it carries the clamp's moment alone), and 9-node elements of
+#: aspect 20 are far too stiff in that bending (c4: +16 % at aspect 20, +0.5 % at 5 against the
+#: fine level; docs/meshes.md)
+MAX_DEBOND_ASPECT = 5.0
 
 
 @dataclass(frozen=True)
@@ -33,6 +38,7 @@ class Sizing:
     refine: int
     tip_size: float  # element length along x at crack tips, load edges and supports
     far_size: float  # element length along x far from them
+    debond_size: float  # the same over a debond (at most far_size)
     growth: float  # largest ratio of neighbouring element lengths along x
     core_half_elements: int  # elements from each interface to the core mid-plane
     core_growth: float  # element length ratio interface -> mid-plane, per element
@@ -85,9 +91,12 @@ def sizing_for(scene: Scene, level: str | None = None, refine: int | None = None
             raise ValueError("level 'explicit' needs reference2d.core_size (mm)")
         far = opts.face_size if opts.face_size is not None else opts.core_size
         tip = opts.tip_size if opts.tip_size is not None else min(far, t_face)
-        return Sizing(level, refine, tip * size_factor, far * size_factor, EXPLICIT_GROWTH,
+        return Sizing(level, refine, tip * size_factor, far * size_factor, far * size_factor,
+                      EXPLICIT_GROWTH,
                       max(1, math.ceil(half_core / opts.core_size - 1e-9)), 1.0, fe, 2**refine)
     far = min(FAR_PER_HEIGHT * scene.total_height, MAX_FACE_ASPECT * t_face / fe)
     tip = min(t_face, far)
-    return Sizing(level, refine, tip * size_factor, far * size_factor, COARSE_GROWTH,
+    debond = max(tip, min(far, MAX_DEBOND_ASPECT * t_face / fe))
+    return Sizing(level, refine, tip * size_factor, far * size_factor, debond * size_factor,
+                  COARSE_GROWTH,
                   CORE_HALF_ELEMENTS, CORE_GROWTH, fe, LEVEL_SUBDIVISION[level] * 2**refine)
