@@ -90,7 +90,9 @@ def profile_columns(
     top/bottom boundary: the interface shear traction), ``u_top, u_bottom`` (axial displacement of
     the faces' mid-surfaces), ``sigma_xx_top_face, sigma_xx_bottom_face`` (face σ_x at
     mid-thickness), ``p_contact_top, p_contact_bottom`` (contact pressure, zero where bonded or
-    open) and ``gap_top, gap_bottom`` (normal gap of debonded pairs, zero where bonded).
+    open), ``gap_top, gap_bottom`` (normal gap of debonded pairs, zero where bonded) and
+    ``sliding_top, sliding_bottom`` (the pairs' tangential sliding, mm; zero where bonded and in
+    a linear analysis).
     """
     u_full = model.expand(u)
     η = _stations(per_element)
@@ -124,11 +126,13 @@ def profile_columns(
     for interface in ("top", "bottom"):
         p_nodes = np.zeros(model.mesh.n_nodes)
         g_nodes = np.zeros(model.mesh.n_nodes)
+        s_nodes = np.zeros(model.mesh.n_nodes)
         for pairs in model.pairs:
             if pairs.interface == interface:
                 if nonlinear:
                     p, k = contact_state(pairs, u_full, model.penalty, model.smoothing)
                     gap = k.gap
+                    s_nodes[pairs.nodes] = k.sliding
                 else:  # the linear analysis' law: plain penalty on the linearised gap
                     v = u_full[pairs.dofs]
                     gap = NORMAL_SIGN[pairs.interface] * (v[:, 1] - v[:, 3])
@@ -136,6 +140,7 @@ def profile_columns(
                 p_nodes[pairs.nodes], g_nodes[pairs.nodes] = p, gap
         out[f"p_contact_{interface}"] = np.interp(x, model.mesh.x, p_nodes)
         out[f"gap_{interface}"] = np.interp(x, model.mesh.x, g_nodes)
+        out[f"sliding_{interface}"] = np.interp(x, model.mesh.x, s_nodes)
     return out
 
 

@@ -4,6 +4,8 @@ Stresses are second Piola–Kirchhoff components S = C : E in the reference (x, 
 element reports them: ``sigma_zz_top``/``sigma_zz_bottom`` is S_zz of the *core* at its top/bottom
 boundary (z = ±h_c/2, evaluated in the core cell), ``tau_core`` is S_xz at the core mid-plane,
 ``tau_top``/``tau_bottom`` S_xz of the core at its top/bottom boundary (interface shear).
+Contact on each interface's debonds, from the face-lip nodes: ``p_contact_*`` (MPa), ``gap_*``
+and ``sliding_*`` (mm; :mod:`sandwich.plane2d.contact`), zero where bonded.
 Stations are the x of the mesh nodes on the top interface.
 """
 
@@ -96,16 +98,20 @@ class ProfileSampler:
             comm = self.model.disc.mesh.comm
             cols[name] = allreduce_array(comm, vals, MPI.SUM) if comm.size > 1 else vals
         for iface in ("top", "bottom"):
-            p_c = np.zeros(len(self.x))
+            lips = {"p_contact": np.zeros(len(self.x)), "gap": np.zeros(len(self.x)),
+                    "sliding": np.zeros(len(self.x))}
             for pair, state, where in zip(self.model.contact_pairs, system.last_contact,
                                           self.model.contact_interfaces, strict=True):
                 if where != iface:
                     continue
                 order = np.argsort(pair.x_ref)
-                xs, ps = pair.x_ref[order], state.pressure[order]
+                xs = pair.x_ref[order]
                 inside = (self.x >= xs[0] - GEOM_TOL) & (self.x <= xs[-1] + GEOM_TOL)
-                p_c[inside] += np.interp(self.x[inside], xs, ps)
-            cols[f"p_contact_{iface}"] = p_c
+                for name, values in (("p_contact", state.pressure), ("gap", state.gap),
+                                     ("sliding", state.slip)):
+                    lips[name][inside] += np.interp(self.x[inside], xs, values[order])
+            for name, values in lips.items():
+                cols[f"{name}_{iface}"] = values
         return cols
 
 
