@@ -38,7 +38,11 @@ Pressure p = k ⟨−g⟩ (MPa).
 the system's sparse matrix holds (:attr:`ContactPair.window`, initially :data:`WINDOW` nodes on
 either side of the coincident node). A slave in contact whose five nodes leave its window is
 reported (:attr:`ContactState.outside`); the system then widens the windows crowded at that
-moment and rebuilds its matrix (:meth:`ContactPair.widen`).
+moment and rebuilds its matrix (:meth:`ContactPair.widen`). Only slaves that penetrate less than
+:attr:`ContactPair.widen_depth` count: the wild iterates of a failing corrector (slaves millimetres
+deep, several millimetres from where they were) would otherwise widen the windows for nothing.
+Entries of a deeper slave's block outside the pattern are left out of that iterate's tangent
+(its force is exact): a state that converges has its slaves shallow.
 """
 
 from __future__ import annotations
@@ -194,6 +198,7 @@ class ContactPair:
     width: float  # b (mm)
     x_ref: np.ndarray  # (ns,) reference x of the slave nodes (for profiles)
     window: np.ndarray | None = None  # (ns, 2) chain positions [lo, hi] the matrix holds
+    widen_depth: float = np.inf  # deeper slaves never widen their windows (mm)
 
     def __post_init__(self):
         """The initial windows: :data:`WINDOW` chain nodes either side of the anchor."""
@@ -235,7 +240,7 @@ class ContactPair:
         def m(a):
             return np.vectorize(lambda k: index[int(k)], otypes=[np.int64])(a)
         return ContactPair(m(self.slave), m(self.master), self.anchor, self.weight,
-                           self.penalty, self.width, self.x_ref, self.window)
+                           self.penalty, self.width, self.x_ref, self.window, self.widen_depth)
 
 
 @dataclass
@@ -252,7 +257,7 @@ class ContactState:
     forces: np.ndarray  # (na, 10) ∂Π/∂X
     tangents: np.ndarray | None  # (na, 10, 10) ∂²Π/∂X² (None unless asked for)
     spans: np.ndarray  # (ns, 2) the chain positions (a − 1, a + 2) of each slave's five nodes
-    outside: np.ndarray  # (no,) active slaves whose five nodes leave their window
+    outside: np.ndarray  # (no,) active slaves, not deeper than widen_depth, out of their window
 
     def nodal_forces(self, n_nodes: int) -> np.ndarray:
         """The forces summed per node, (n_nodes, 2)."""
@@ -303,7 +308,7 @@ def evaluate(pair: ContactPair, x_ref: np.ndarray, u: np.ndarray,
     pressure = pair.penalty * np.maximum(-g, 0.0)
     rows = np.column_stack([s, m[p], m[a], m[b], m[q]])[active]
     lo, hi = pair.window[active, 0], pair.window[active, 1]
-    out = (p[active] < lo) | (q[active] > hi)
+    out = ((p[active] < lo) | (q[active] > hi)) & (g[active] >= -pair.widen_depth)
     outside = active[out]
     return ContactState(g, slip, pressure, a, xi, active, rows, forces, tangents,
                         np.column_stack([p, q]), outside)

@@ -33,6 +33,10 @@ from sandwich.plane2d.system import Reference2DSystem
 from sandwich.scene import Scene
 
 GEOM_TOL = 1e-7  # mm: coordinates closer than this are the same point
+#: A contact slave penetrating deeper than this × the thinner face never widens its window of
+#: master nodes (10 × the penetration the default penalty allows at E_z,min / 5;
+#: :mod:`sandwich.plane2d.contact`)
+WIDEN_DEPTH = 1e-2
 
 
 def layer_bands(scene: Scene) -> list[LayerBand]:
@@ -248,6 +252,7 @@ def contact_pairs(scene: Scene, mesh, disc: Discretisation,
                   penalty: float) -> tuple[list[ct.ContactPair], list[str]]:
     """Finite-sliding contact data (:mod:`sandwich.plane2d.contact`) of every debond with lips."""
     pairs, ifaces = [], []
+    h_face = min(scene.top.thickness, scene.bottom.thickness)
     lip_pairs = getattr(mesh, "lip_pairs", {}) or {}
     pts = np.asarray(mesh.points)[:, :2]
     for i, debond in enumerate(scene.debonds):
@@ -278,6 +283,7 @@ def contact_pairs(scene: Scene, mesh, disc: Discretisation,
         # a missing tip is an open mouth (debond reaching the beam end): no bonded corner there
         x_tips = [None if t is None else float(pts[t, 0]) for t in tips]
         weight = ct.slave_weights(x_face, x_tips[0], x_tips[1])  # start < end (scene checks)
-        pairs.append(ct.ContactPair(slave, master, anchor, weight, penalty, scene.width, x_face))
+        pairs.append(ct.ContactPair(slave, master, anchor, weight, penalty, scene.width, x_face,
+                                    widen_depth=WIDEN_DEPTH * h_face))
         ifaces.append(debond.interface)
     return pairs, ifaces
