@@ -11,14 +11,16 @@ steps taken under probe control, the largest sliding of a face-lip node in conta
 penetration over the face thickness, the times the contact windows were widened, and the seconds.
 
     python -m benchmarks.sliding_contact_2d            # coarse, medium, fine on c3 and c4
-    python -m benchmarks.sliding_contact_2d --levels coarse medium
+    python -m benchmarks.sliding_contact_2d --scenes c4 --levels coarse medium
 
-Writes ``benchmarks/results/reference2d/sliding_contact_2d.{csv,md}``.
+Writes ``benchmarks/results/reference2d/sliding_contact_2d.{csv,md}``; a run of some scenes
+replaces their rows and keeps the others' (each row says when it was measured).
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import re
 import time
 
@@ -30,7 +32,7 @@ OUT = RESULTS / "reference2d"
 LEVELS = ("coarse", "medium", "fine")
 #: λ(−40) of the independent finite-sliding model (module docstring), quoted
 FINITE_SLIDING = {"c4": 43.83 * 1.027}
-FIELDS = ["scene", "level", "cells", "lambda_20", "lambda_30", "lambda_40", "states",
+FIELDS = ["measured", "scene", "level", "cells", "lambda_20", "lambda_30", "lambda_40", "states",
           "rescues", "max_sliding", "max_penetration_over_face", "window_growths", "seconds",
           "status"]
 
@@ -71,17 +73,19 @@ def _pct(a, b) -> str:
     return "—" if a is None or b is None else f"{100 * (a / b - 1):+.2f} %"
 
 
-def table(rows: list[dict], stamp: str) -> str:
+def table(rows: list[dict]) -> str:
     finest = {}
-    for r in rows:  # the last level run of each scene is its finest
+    for r in sorted(rows, key=lambda r: LEVELS.index(r["level"])):  # each scene's finest level
         finest[r["scene"]] = r
     lines = ["# The 2D model on the sliding cantilevers c3, c4 "
-             "(`benchmarks/sliding_contact_2d.py`)", "", stamp, "",
+             "(`benchmarks/sliding_contact_2d.py`)", "",
+             "Measured on " + "; ".join(sorted({r["measured"] for r in rows})) + ".", "",
              __doc__.split("\n\n")[1].replace("\n", " "), "",
              "| scene | level | cells | λ(−20) | λ(−30) | λ(−40) | vs finest here | "
              "vs finite-sliding (≈) | states | rescues | max sliding (mm) | "
              "penetration / h_face | window growths | seconds |",
              "|---|---|---:|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|"]
+    rows = sorted(rows, key=lambda r: (r["scene"], LEVELS.index(r["level"])))
     for r in rows:
         lam = r["lambda_40"]
         top = finest[r["scene"]]
@@ -102,15 +106,22 @@ def main() -> None:
     ap.add_argument("--levels", nargs="+", choices=LEVELS, default=list(LEVELS))
     ap.add_argument("--scenes", nargs="+", choices=list(SCENES), default=list(SCENES))
     args = ap.parse_args()
-    stamp = measured_on()
+    path = args.out / "sliding_contact_2d.csv"
     rows = []
+    if path.is_file():  # the other scenes' rows are kept
+        with open(path, newline="") as f:
+            rows = [{k: v if k in ("measured", "scene", "level", "status") else
+                     None if v == "" else float(v) for k, v in r.items()}
+                    for r in csv.DictReader(f) if r["scene"] not in args.scenes]
     for case in args.scenes:
         for level in args.levels:
-            row = {"scene": case, "level": level, **measure(case, level)}
+            stamp = measured_on()
+            row = {"measured": stamp.removeprefix("Measured on ").rstrip("."), "scene": case,
+                   "level": level, **measure(case, level)}
             print(row, flush=True)
             rows.append(row)
-    write_rows(args.out / "sliding_contact_2d.csv", FIELDS, rows)
-    (args.out / "sliding_contact_2d.md").write_text(table(rows, stamp))
+            write_rows(path, FIELDS, rows)  # each row as soon as it is measured
+    (args.out / "sliding_contact_2d.md").write_text(table(rows))
 
 
 if __name__ == "__main__":
