@@ -8,11 +8,10 @@ beam converging in levels and elements. Columns: λ at w_top_tip = −20, −30,
 follower's rescues, from the run's message), the largest sliding of a pair in contact, pairs in
 contact outside their search window at the end, and the solve's seconds.
 
-References (other models, quoted, not computed here): the 2D model's λ(−40) on its medium and
-fine meshes (`benchmarks/results/comparisons/gallery_agreement_c3_c4_d16.md`, small-sliding lip
-contact: c4 medium 44.49, fine 43.83; c3 medium 45.60), and the independent finite-sliding
-plane-stress model issue 51 cites (kept outside the project, mesh-checked to ≈ 0.3 %): within
-0.5 % of 2D medium up to −30 mm, and ≈ 2.7 % above 2D fine at −40 mm on c4 (≈ 45.0).
+References (other models): the 2D model's λ(−40) on its medium and fine meshes, read from
+`benchmarks/results/reference2d/sliding_contact_2d.csv` (`benchmarks/sliding_contact_2d.py`,
+finite-sliding lip contact), and the independent finite-sliding plane-stress model issue 51
+cites (kept outside the project, mesh-checked to ≈ 0.3 %; quoted: ≈ 45.0 at −40 mm on c4).
 
     python -m benchmarks.sliding_contact   # benchmarks/results/beam/sliding_contact.{csv,md}
 """
@@ -37,9 +36,22 @@ VARIANTS = [("defaults (auto, 240 el.)", None, None), ("L1, 240 el.", 1, None),
             ("L2, 240 el.", 2, None), ("L3, 240 el.", 3, None), ("L2, 480 el.", 2, 480),
             ("L3, 480 el.", 3, 480)]
 AT = (-20.0, -30.0, -40.0)
-#: λ(−40) of the other models (module docstring): 2D medium and fine, the finite-sliding one
-REFERENCES = {"c3": {"2D medium": 45.60}, "c4": {"2D medium": 44.49, "2D fine": 43.83,
-                                                 "finite-sliding (≈)": 43.83 * 1.027}}
+#: λ(−40) of the independent finite-sliding model (module docstring), quoted
+FINITE_SLIDING = {"c4": 43.83 * 1.027}
+TWO_D = RESULTS / "reference2d" / "sliding_contact_2d.csv"
+
+
+def references() -> dict[str, dict[str, float]]:
+    """λ(−40) of the other models per scene: 2D medium and fine (where measured), finite-sliding."""
+    refs: dict[str, dict[str, float]] = {c: {} for c in SCENES}
+    if TWO_D.is_file():
+        with open(TWO_D, newline="") as f:
+            for r in csv.DictReader(f):
+                if r["level"] in ("medium", "fine") and r["lambda_40"]:
+                    refs[r["scene"]][f"2D {r['level']}"] = float(r["lambda_40"])
+    for c, v in FINITE_SLIDING.items():
+        refs[c]["finite-sliding (≈)"] = v
+    return refs
 FIELDS = ["scene", "variant", "lambda_20", "lambda_30", "lambda_40", "states", "rescues",
           "max_sliding", "outside_window", "seconds", "status"]
 
@@ -92,8 +104,9 @@ def table(rows: list[dict], stamp: str) -> str:
              "| scene | run | λ(−20) | λ(−30) | λ(−40) | vs 2D fine / medium at −40 | "
              "vs finite-sliding (≈) | states | rescues | max sliding (mm) | outside window | "
              "seconds |", "|---|---|---:|---:|---:|---|---|---:|---:|---:|---:|---:|"]
+    refs_all = references()
     for r in rows:
-        refs = REFERENCES[r["scene"]]
+        refs = refs_all[r["scene"]]
         lam = r["lambda_40"]
         vs = " / ".join(f"{k.split()[1]} {100 * (lam / refs[k] - 1):+.2f} %" if lam else "—"
                         for k in ("2D fine", "2D medium") if k in refs)
@@ -107,8 +120,8 @@ def table(rows: list[dict], stamp: str) -> str:
             f"{r['outside_window']:.0f} | "
             f"{r['seconds']:.1f} |")
     lines += ["", "References: " + "; ".join(f"{c}: " + ", ".join(f"{k} {v:.2f}" for k, v in
-                                                                  REFERENCES[c].items())
-                                             for c in REFERENCES) + " (λ at −40 mm)."]
+                                                                  refs_all[c].items())
+                                             for c in refs_all) + " (λ at −40 mm)."]
     return "\n".join(lines) + "\n"
 
 

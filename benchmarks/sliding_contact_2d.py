@@ -13,8 +13,8 @@ penetration over the face thickness, the times the contact windows were widened,
     python -m benchmarks.sliding_contact_2d            # coarse, medium, fine on c3 and c4
     python -m benchmarks.sliding_contact_2d --scenes c4 --levels coarse medium
 
-Writes ``benchmarks/results/reference2d/sliding_contact_2d.{csv,md}``; a run of some scenes
-replaces their rows and keeps the others' (each row says when it was measured).
+Writes ``benchmarks/results/reference2d/sliding_contact_2d.{csv,md}``; a run of some scenes and
+levels replaces their rows and keeps the others (each row says when it was measured).
 """
 
 from __future__ import annotations
@@ -112,7 +112,8 @@ def main() -> None:
         with open(path, newline="") as f:
             rows = [{k: v if k in ("measured", "scene", "level", "status") else
                      None if v == "" else float(v) for k, v in r.items()}
-                    for r in csv.DictReader(f) if r["scene"] not in args.scenes]
+                    for r in csv.DictReader(f)
+                    if r["scene"] not in args.scenes or r["level"] not in args.levels]
     for case in args.scenes:
         for level in args.levels:
             stamp = measured_on()
