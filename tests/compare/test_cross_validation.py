@@ -62,10 +62,10 @@ def _solvers():
     return {m: MODELS[m].solve for m in ("beam", "2d")}
 
 
-def _compare(tmp_path, name, until, level=REF_LEVEL):
+def _compare(tmp_path, name, until, level=REF_LEVEL, **analysis):
     scene = load_scene(ROOT / "scenes" / f"{name}.toml")
     scene = dataclasses.replace(
-        scene, analysis=dataclasses.replace(scene.analysis, until_value=until),
+        scene, analysis=dataclasses.replace(scene.analysis, until_value=until, **analysis),
         reference2d=dataclasses.replace(scene.reference2d, level=level, refine=0))
     cmp = compare(scene, tmp_path / "out", results_root=tmp_path / "res", reuse=False,
                   solvers=_solvers())
@@ -98,8 +98,15 @@ def test_fig5_beyond_face_buckling(tmp_path):
     stiff here (a strict xfail until the core hierarchy), auto core levels with the paper's faces
     1.0 % (L2) / 1.5 % (max) against 2D coarse; with the stretch faces, averaged membrane and
     closest-point contact (the defaults since 2026-12-02) 0.21 % / 0.39 %, so it is held to the
-    same 1 % / 1.5 % as the paths before buckling (was 3 % / 5 %)."""
-    cmp = _compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0)
+    same 1 % / 1.5 % as the paths before buckling (was 3 % / 5 %).
+
+    Both models run under displacement control in 0.25-mm steps, so that both histories sample
+    the buckling knee at the same deflections: under arc-length each model's own steps cut the
+    knee's corner differently, and the piecewise-linear curves then differ by the sampling
+    (1.96 % max, measured 2026-12-07, where 2D coarse stepped from −2.52 to −3.26 mm across the
+    knee while the beam's states at −3.0 mm agree with it within 0.6 %)."""
+    cmp = _compare(tmp_path, "paper-fig5-top-debond-40-load-top", -5.0,
+                   control="displacement", initial_increment=0.25, max_increment=0.25)
     _load_curve_agrees(cmp)
 
 
