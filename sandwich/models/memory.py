@@ -8,12 +8,36 @@ Each estimate is a model of the peak resident set size of the command's process,
 RSS measured by ``benchmarks/memory_guard.py`` on ``scenes/default.toml``
 (``benchmarks/results/memory/memory_guard.md``: the rows, the fit and its error):
 
-- **beam**: ``BEAM_BASE + BEAM_PER_WORK · elements · z · d`` where, at the core level ℓ the
-  solve may build (:func:`beam_level`), ``z`` is the number of Gauss points through the core and
-  ``d`` the DOFs of an element (both from :mod:`sandwich.beam.core_basis`): the element arrays the
-  vectorised assembly holds at once scale with their product (measured: 0.93–1.13 of the peak at
-  levels 1, 3, 4 and 5). Plus every converged state the path keeps (``8 · DOFs`` bytes each,
-  ``analysis.max_steps`` of them at most; twice for ``"auto"``, which keeps the pass it checks).
+- **beam**: ``BEAM_BASE + BEAM_PER_ELEMENT · elements + BEAM_PER_DOF · DOFs + contact +
+  states``, summed over the models the solve holds at once (:func:`held_levels`: one at the
+  fixed level; for ``"auto"`` the path's at ``max_core_level`` and its check's
+  :data:`~sandwich.beam.core_levels.LOOKAHEAD` levels above), each with every node at its
+  level. Per element what does not grow with the core level (the faces' arrays and slot maps,
+  the mesh, the fields); per DOF the tangent's values and their spares and the envelope factors
+  held at once (the path's last state's and the corrector's).
+- **contact term** (closest-point contact on a debond, nonlinear analysis:
+  :func:`closest_point_growth`): ``CONTACT_PER_ENTRY · E`` per model held, E the entries of its
+  tangent's sparsity pattern (:func:`pattern_entries`). A closest-point pair's pattern holds the
+  core segments next to its node; as the faces slide past them it grows by the segments met,
+  and the envelope LDLᵀ's symbolic structure (:class:`~sandwich.solver.envelope.EnvelopeStructure`,
+  whose maps are the size of the pattern, not of the factor) is built again on the grown
+  pattern and widened as pairs close. While a widened structure is built, the one it replaces
+  is still held: per entry of the pattern, the new structure's slot map (8 bytes: two int64 per
+  entry of the stored triangle, half the entries), its runs (12 bytes: three int64 per run, runs
+  of about one entry in the reverse Cuthill-McKee order a widening takes) and its values'
+  pattern (8 bytes), the full-length slot map its construction holds before cutting it to the
+  triangle (16 bytes) and the next factor's storage (≈ 5 bytes): 49 bytes, derived, not fitted
+  (measured at core level 1, 8000 and 16000 elements: 63 and 56 bytes per entry above the
+  same-x run, whose pattern never grows). On the scene's own path the faces slide past a
+  segment at any useful resolution (the default scene at core level 1: from 2000 elements on by
+  w_top_mid = −2 mm), so the term is always counted.
+- **states**: every converged state the path keeps (``8 · DOFs`` bytes each at the highest
+  level, ``analysis.max_steps`` of them at most; twice for ``"auto"``, which keeps the pass it
+  checks).
+- Not covered: where a tangent's pivot-free LDLᵀ is refused (a tiny pivot), the beam
+  factorises it with SuperLU's pivoting LU (:class:`~sandwich.solver.sparse.SparseFactorization`),
+  whose factors are several times the envelope's; such runs peak well above the estimate (the
+  table's last section).
 - **2D solve**: ``TWO_D_BASE + TWO_D_PER_DOF · n · log2(n)`` for ``n`` DOFs (the MUMPS LDLᵀ factor
   of a 2D mesh under nested dissection grows as n log n), plus the kept states as above. ``n`` is
   twice the nodes of the 9-node quadrilateral mesh, whose cell count is computed exactly from the
@@ -35,12 +59,17 @@ GB = 1e9
 STATE_BYTES_PER_DOF = 8.0  # a kept converged state: its float64 displacement vector
 
 # Fitted by benchmarks/memory_guard.py (benchmarks/results/memory/memory_guard.md)
-BEAM_BASE = 204.6e6  # bytes
-BEAM_PER_WORK = 194.0  # bytes per element, core Gauss point and element DOF
-TWO_D_BASE = 169.0e6  # bytes
-TWO_D_PER_DOF = 189.5  # bytes per DOF and log2(DOFs)
-MESH_BASE = 92.61e6  # bytes
-MESH_PER_CELL = 1736.0  # bytes per cell
+BEAM_BASE = 38.39e6  # bytes
+BEAM_PER_ELEMENT = 22496.0  # bytes per element of the models held
+BEAM_PER_DOF = 1444.5  # bytes per DOF of the models held
+# Derived (module docstring): a widened envelope structure and its construction, per entry of
+# the tangent's pattern, while the structure it replaces is still held
+CONTACT_PER_ENTRY = 8.0 + 12.0 + 8.0 + 16.0 + 5.0  # bytes
+ENTRY_SAMPLE = (60, 120)  # elements of the two small models the entries are counted on
+TWO_D_BASE = 179.9e6  # bytes
+TWO_D_PER_DOF = 192.0  # bytes per DOF and log2(DOFs)
+MESH_BASE = 92.49e6  # bytes
+MESH_PER_CELL = 1797.2  # bytes per cell
 
 
 @dataclass(frozen=True)
@@ -74,7 +103,8 @@ def beam_level(scene: Scene) -> tuple[int, str]:
     A fixed ``core`` (raised by ``core_zones``) is that level. ``"auto"`` follows its path up to
     ``max_core_level``, but its error indicator builds the model with every element
     :data:`~sandwich.beam.core_levels.LOOKAHEAD` levels higher (up to the top level): at worst,
-    with every element at the cap, that is the model it holds.
+    with every element at the cap, that is the largest model it holds (with the path's own,
+    :func:`held_levels`).
     """
     from sandwich.beam.core_basis import MAX_LEVEL
     from sandwich.beam.core_levels import LOOKAHEAD
@@ -90,24 +120,82 @@ def beam_level(scene: Scene) -> tuple[int, str]:
     return level, f"core level {level}"
 
 
-def _beam_sizes(scene: Scene) -> tuple[int, int, int, str]:
-    """Elements, DOFs, the work feature (elements × core Gauss points × element DOFs), words."""
-    from sandwich.beam.core_basis import CoreBasis
-    from sandwich.beam.dofs import NODE_DOFS, NODES_PER_ELEMENT
+def held_levels(scene: Scene) -> tuple[int, ...]:
+    """Core levels of the beam models a solve of ``scene`` holds at once, every element at each.
 
+    A fixed ``core``: one model, :func:`beam_level`'s. ``"auto"``: the path's model (at most
+    ``max_core_level``) and its check's (:func:`beam_level`), which re-converges the path's
+    states while the path's model is kept.
+    """
+    level = beam_level(scene)[0]
     bm = scene.beam_model
+    if bm.core != "auto":
+        return (level,)
+    zones = max((z.level for z in bm.core_zones), default=1)
+    return (max(int(bm.max_core_level), zones), level)
+
+
+def _dofs_at(scene: Scene, level: int) -> int:
+    """DOFs of the beam model of ``scene`` with every node at core ``level``."""
+    from sandwich.beam.core_basis import CoreBasis
+    from sandwich.beam.dofs import NODE_DOFS
+
+    basis = CoreBasis(scene.beam_model.core_basis, level)
+    return (int(scene.beam_model.elements) + 1) * (NODE_DOFS + 4 * basis.count(level))
+
+
+def _beam_sizes(scene: Scene) -> tuple[int, int, str]:
+    """Elements, DOFs at the level of :func:`beam_level`, words."""
     level, why = beam_level(scene)
-    basis = CoreBasis(bm.core_basis, level)
-    node_dofs = NODE_DOFS + 4 * basis.count(level)
-    n = int(bm.elements)
-    work = n * len(basis.rule(level)[0]) * NODES_PER_ELEMENT * node_dofs
-    dofs = (n + 1) * node_dofs
-    return n, dofs, work, f"{n} elements at {why}, {dofs} DOFs"
+    n = int(scene.beam_model.elements)
+    dofs = _dofs_at(scene, level)
+    return n, dofs, f"{n} elements at {why}, {dofs} DOFs"
 
 
-def beam_work(scene: Scene) -> int:
-    """Elements × core Gauss points × element DOFs at the level of :func:`beam_level`."""
-    return _beam_sizes(scene)[2]
+def beam_dofs(scene: Scene) -> int:
+    """DOFs of the beam models a solve holds at once (:func:`held_levels`), summed."""
+    return sum(_dofs_at(scene, level) for level in held_levels(scene))
+
+
+def beam_elements(scene: Scene) -> int:
+    """Elements of the beam models a solve holds at once (:func:`held_levels`), summed."""
+    return len(held_levels(scene)) * int(scene.beam_model.elements)
+
+
+def closest_point_growth(scene: Scene) -> bool:
+    """Whether the contact term applies: closest-point pairs on a debond, a nonlinear path."""
+    return (bool(scene.debonds) and scene.analysis.kind == "nonlinear"
+            and scene.beam_model.contact_search == "closest-point")
+
+
+def pattern_entries(scene: Scene, level: int) -> int:
+    """Entries of the beam tangent's sparsity pattern with every element at core ``level``.
+
+    Counted on the scene's own model at :data:`ENTRY_SAMPLE` elements (built in milliseconds,
+    nothing solved): the entries per element between the two (the layers' blocks and the
+    debonds' contact pairs; the fixed part of the supports and ends cancels) times
+    ``beam_model.elements``. Within 0.3 % of the pattern of the full model on the default scene
+    at 2000 elements (level 1, 3, 5).
+    """
+    from sandwich.beam.build import build_model, scene_model_options
+
+    small, large = ENTRY_SAMPLE
+    count = [build_model(scene, elements=m, core_level=level,
+                         **scene_model_options(scene)).pattern.indices.size
+             for m in ENTRY_SAMPLE]
+    per_element = (count[1] - count[0]) / (large - small)
+    return int(round(count[0] + per_element * (int(scene.beam_model.elements) - small)))
+
+
+def contact_bytes(scene: Scene) -> float:
+    """The contact term: ``CONTACT_PER_ENTRY`` × :func:`pattern_entries` where it applies.
+
+    Of every model held at once (:func:`held_levels`): each grows its own pattern.
+    """
+    if not closest_point_growth(scene):
+        return 0.0
+    return CONTACT_PER_ENTRY * sum(pattern_entries(scene, level)
+                                   for level in held_levels(scene))
 
 
 def states_bytes(scene: Scene, model: str, states: int | None = None) -> float:
@@ -126,8 +214,9 @@ def beam_estimate(scene: Scene, states: int | None = None) -> MemoryEstimate:
     ``states``: converged states kept (default: every step of ``analysis.max_steps``).
     """
     bm = scene.beam_model
-    n, dofs, work, detail = _beam_sizes(scene)
-    peak = BEAM_BASE + BEAM_PER_WORK * work + states_bytes(scene, "beam", states)
+    n, dofs, detail = _beam_sizes(scene)
+    peak = (BEAM_BASE + BEAM_PER_ELEMENT * beam_elements(scene) + BEAM_PER_DOF * beam_dofs(scene)
+            + contact_bytes(scene) + states_bytes(scene, "beam", states))
     keys = ("beam_model.elements", "beam_model.max_core_level" if bm.core == "auto"
             else "beam_model.core", "analysis.max_steps")
     return MemoryEstimate("beam solve", peak, dofs, detail, keys)
