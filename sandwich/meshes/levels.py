@@ -25,7 +25,7 @@ FAR_PER_HEIGHT = 0.2  # coarse far-field element length as a fraction of the bea
 MAX_FACE_ASPECT = 20.0  # coarse far-field element length / face element thickness, at most
 #: coarse element length / face element thickness, at most, over a debond: a debonded face bends
 #: on its own there (at a clamp it carries the clamp's moment alone), and 9-node elements of
-#: aspect 20 are far too stiff in that bending (c4: +16 % at aspect 20, +0.5 % at 5 against the
+#: aspect 20 are far too stiff in that bending (c4: +16 % at aspect 20, +0.7 % at 5 against the
 #: fine level; docs/meshes.md)
 MAX_DEBOND_ASPECT = 5.0
 

@@ -93,4 +93,8 @@ def test_fig5_bifurcation_is_located_within_its_step_and_the_path_is_unchanged()
     assert p.between == (before, at_state) and before < p.load_factor < at_state
     assert 0.0 < p.located_at < 1.0
     assert before <= n.between[0] < n.load_factor < n.between[1] <= at_state
-    assert n.between[1] - n.between[0] < 0.5 * (at_state - before)
+    # narrowed: an equilibrium inside the step replaced an end of the bracket. Narrowing stops
+    # when the located load changes by <= LOCATE_RTOL between tries (docs/solver.md), not at a
+    # bracket width: on the coarse mesh refined over the debond (measured 2026-12-07) one try
+    # moved the lower end from 600.19 to 610.27 in a 600.19-620.49 step and the estimate held
+    assert n.between[1] - n.between[0] < at_state - before
