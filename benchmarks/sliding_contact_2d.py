@@ -8,8 +8,9 @@ converging. Columns: λ at w_top_tip = −20, −30, −40 mm (interpolated in t
 plane-stress model issue 51 cites (kept outside the project, mesh-checked to ≈ 0.3 %; quoted as
 ≈ 45.0 on c4 at −40 mm, 2.7 % above the earlier small-sliding 2D fine 43.83), converged states,
 steps taken under probe control, the largest sliding of a face-lip node in contact, the largest
-penetration over the face thickness, the times the contact windows were widened, and the seconds (as measured, with other jobs
-running on the machine: not a speed comparison, see ``docs/speed.md``).
+penetration over the face thickness, the times the contact windows were widened, and the
+seconds (as measured, with other jobs running on the machine: not a speed comparison, see
+``docs/speed.md``).
 
     python -m benchmarks.sliding_contact_2d            # coarse, medium, fine on c3 and c4
     python -m benchmarks.sliding_contact_2d --scenes c4 --levels coarse medium
