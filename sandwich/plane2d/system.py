@@ -9,7 +9,7 @@ around it; a slave in contact that slides out of its window widens it, and the m
 (and MUMPS analyses it afresh).
 
 MPI: numpy vectors are the rank's owned DOFs. The two lips of a debond share no cell, so a
-slave's anchor and chord nodes are often on another rank: the displacements of all contact nodes
+slave's master nodes are often on another rank: the displacements of all contact nodes
 (a few hundred) are gathered to every rank, every rank evaluates all the contact, and each adds
 only the rows it owns. The matrix is created here (not by dolfinx) from the form's sparsity
 pattern plus the contact couplings in global numbering, so off-rank contact columns have slots.
