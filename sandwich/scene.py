@@ -105,6 +105,19 @@ class Toughness:
 
 
 @dataclass(frozen=True)
+class Growth:
+    """How a debond is grown by crack-length control (:mod:`sandwich.growth`).
+
+    The debond's tips advance by ``step`` (mm) one at a time, each time at the load where its
+    G reaches the Benzeggagh–Kenane toughness, until the debond is ``max_length`` long (mm;
+    ``None``: until a tip comes within one step of a beam end or of another debond).
+    """
+
+    step: float = 2.0
+    max_length: float | None = None
+
+
+@dataclass(frozen=True)
 class Debond:
     """A debonded stretch [start, end] (mm) of the top or bottom face/core interface."""
 
@@ -112,6 +125,7 @@ class Debond:
     start: float
     end: float
     toughness: Toughness | None = None  # optional: report the first step where it grows
+    growth: Growth | None = None  # optional (needs a toughness): grow it, crack-length control
 
     @property
     def length(self) -> float:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sandwich.fracture import growth_onset, ill_conditioned_releases, missing_releases
+from sandwich.growth import final_scene, grow, growing
 from sandwich.models.registry import get_model
 from sandwich.results import (
     InterruptedSolve,
@@ -150,7 +151,13 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
     folder = Path(folder)
     check_output_folder(folder)
     identity = spec.identity(scene, root)
-    solve = solver or spec.solve
+    model_solve = solver or spec.solve
+    if growing(scene):  # debonds grown by crack-length control: a path per length
+
+        def solve(scene: Scene, progress=None) -> Solution:
+            return grow(scene, model_solve, progress)
+    else:
+        solve = model_solve
     streamed: list[StepRecord] = []
 
     def on_state(item: ProgressItem) -> None:
@@ -188,8 +195,8 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
     if near:  # either model: G close below a critical load
         solution.warnings.append(near)
     solution.extra[IDENTITY_KEY] = identity.to_dict()
-    if mpi_rank() == 0:
-        _write(solution, folder, scene)
+    if mpi_rank() == 0:  # a grown debond's tips are where its growth left them
+        _write(solution, folder, final_scene(scene, solution) if growing(scene) else scene)
     return solution
 
 

@@ -13,6 +13,7 @@ from sandwich.scene import (
     SUPPORT_SITES,
     SUPPORT_TYPES,
     Debond,
+    Growth,
     Load,
     Probe,
     Support,
@@ -39,7 +40,7 @@ def read_debonds(r: Reader, arr: Any, L: float | None) -> list[Debond]:
     out: list[tuple[int, Debond]] = []
     for i, d in enumerate(r.array_of_tables(arr, "debonds")):
         key = f"debonds[{i}]"
-        t = r.table(d, key, ("interface", "start", "end", "toughness"),
+        t = r.table(d, key, ("interface", "start", "end", "toughness", "growth"),
                     required=("interface", "start", "end"))
         if t is None:
             continue
@@ -50,8 +51,9 @@ def read_debonds(r: Reader, arr: Any, L: float | None) -> list[Debond]:
             r.fail(f"{key}.end", f"end {b:g} is before start {a:g}")
             continue
         tough = _toughness(r, t, key, a, b)
+        grow = _growth(r, t, key, a, b, L, tough)
         if None not in (itf, a, b):
-            out.append((i, Debond(itf, a, b, tough)))
+            out.append((i, Debond(itf, a, b, tough, grow)))
     for itf in INTERFACES:
         same = sorted((x for x in out if x[1].interface == itf), key=lambda x: x[1].start)
         for (i, d1), (j, d2) in zip(same, same[1:], strict=False):
@@ -80,6 +82,33 @@ def _toughness(r: Reader, t: dict[str, Any], key: str, a: float | None,
     if None in (gic, giic, eta):
         return None
     return Toughness(gic, giic, eta)
+
+
+def _growth(r: Reader, t: dict[str, Any], key: str, a: float | None, b: float | None,
+            L: float | None, tough: Toughness | None) -> Growth | None:
+    """``growth = { step, max_length }`` of a debond (mm): grown by crack-length control."""
+    if "growth" not in t:
+        return None
+    key = f"{key}.growth"
+    gt = r.table(t["growth"], key, ("step", "max_length"))
+    if gt is None:
+        return None
+    if "toughness" not in t:
+        r.fail(key, "growth needs the debond's toughness = { GIc, GIIc } (N/mm): it decides "
+               "at what load each tip advances")
+        return None
+    step = r.number(gt, "step", key, default=2.0, positive=True)
+    most = r.number(gt, "max_length", key, default=None, positive=True)
+    if None in (step, a, b) or tough is None:
+        return None
+    if most is not None and most < b - a + step - GEOMETRY_TOL:
+        r.fail(f"{key}.max_length", f"{most:g} mm leaves no room to grow the debond "
+               f"[{a:g}, {b:g}] ({b - a:g} mm long) by one step of {step:g} mm")
+        return None
+    if L is not None and step > 0.25 * L:
+        r.fail(f"{key}.step", f"{step:g} mm is more than a quarter of the beam ({L:g} mm)")
+        return None
+    return Growth(step, most)
 
 
 def read_supports(r: Reader, arr: Any, L: float | None) -> list[Support]:
