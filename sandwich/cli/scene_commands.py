@@ -73,6 +73,18 @@ class _StepBar:
             self.bar(SimpleNamespace(step=0, load_factor=0.0, probes={}, message=event.message))
 
 
+def growth_line(growth: dict) -> str:
+    """What a growth run found, in one line (summary ``debond_growth`` of a growth run)."""
+    if growth.get("first_growth_load") is None:
+        return f"  growth: none ({growth['stopped']})"
+    at_least = "" if growth["bounded"] else "at least "
+    moved = "; ".join(f"debond {i} [{d['from'][0]:g}, {d['from'][1]:g}] -> "
+                      f"[{d['to'][0]:g}, {d['to'][1]:g}]" for i, d in growth["debonds"].items())
+    return (f"  growth: first at load factor {growth['first_growth_load']:.6g}, residual "
+            f"strength {at_least}{growth['residual_strength']:.6g}; {growth['stable_steps']} "
+            f"stable, {growth['unstable_steps']} unstable step(s); {moved}")
+
+
 def written_files(folder: Path) -> str:
     """The result files in ``folder``, the field frames counted: what a solve wrote there."""
     from sandwich.results.writing import is_result_file
@@ -143,6 +155,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
                  f"{lp.between[1]:.6g})" if lp.located_at is not None and lp.between
                  else f"at step {lp.step}")
         say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
+    growth = sol.extra.get("debond_growth")
+    if isinstance(growth, dict) and "method" in growth:
+        say(args, growth_line(growth))
     say(args, accuracy_line(args.model, sol))
     say(args, f"results in {out}/ ({written_files(out)})")
     for w in sol.warnings if mpi_rank() == 0 else ():

@@ -2,7 +2,8 @@
 
 Overlay figures (PNG + CSV each), G at every debond tip along the path (``G_<tip>.png``,
 ``energy_release.csv``), the interface tractions ahead of each tip (``tip_tractions.csv``),
-deformed pictures and ``metrics.json``.
+deformed pictures and ``metrics.json``; where debonds grow, the growth envelopes
+(:mod:`sandwich.compare.growth`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 
 from sandwich.compare.deformed import draw_face_lines, draw_picture, last_picture, shared_view
 from sandwich.compare.face_lines import face_lines
+from sandwich.compare.growth import growth_figures
 from sandwich.compare.metrics import Metrics, compute_metrics
 from sandwich.compare.pair import BEAM, PAIR, REFERENCE
 from sandwich.compare.paths import LOAD, Curve, limit_loads, path_parameter, series
@@ -264,6 +266,9 @@ def compare(scene: Scene | str | Path, out_dir: str | Path, *, reuse: bool = Tru
     cmp.tables += write_tip_tractions(scene, cmp.chosen_profiles, out_dir)
     _profile_figures(cmp, abscissa)
     _deformed_figures(cmp)
+    figures, tables = growth_figures(scene, cmp.solutions, out_dir, total_force(scene))
+    cmp.figures += figures
+    cmp.tables += tables
     atomic_write_text(out_dir / "metrics.json",
                       json.dumps(metrics.to_dict(), indent=2, allow_nan=False) + "\n")
     return cmp

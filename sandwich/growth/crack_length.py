@@ -121,12 +121,7 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
                 for t in open_tips(scene, i))
     while True:
         say(PathNote(f"growth stage {stage}: " + _lengths(current), restart=False))
-
-        def inner(item: ProgressItem, stage: int = stage) -> None:
-            if not isinstance(item, PathNote):
-                say(PathNote(f"growth stage {stage}: step {item.step}, λ={item.load_factor:.6g}",
-                             restart=False))
-
+        inner = None  # a stage's own path states are not the growth run's: not streamed
         try:
             solution = solve(current, progress=inner)
         except KeyboardInterrupt:

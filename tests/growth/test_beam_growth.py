@@ -1,6 +1,6 @@
 """Growth by crack-length control in the beam model, against closed forms.
 
-The face cantilever of ``benchmarks.cases.fracture_cases`` (an end force on the top face at an
+The face cantilever of ``benchmarks.cases.growth_cases`` (an end force on the top face at an
 open mouth, the tip at a, linear analysis): beam theory with a root rotation gives
 G = 6 P² (a + χ t)² / (b² E t³) with χ independent of a, so the onset load of each length is
 λ_c = √(G_c b² E t³ / 6) / (a + χ t): 1/λ_c is linear in a with the closed-form slope
@@ -10,30 +10,18 @@ which the central differences of the envelope give at the mid lengths (the compl
 an energy estimate independent of the virtual crack closure that drives the growth).
 """
 
-import dataclasses
-
 import numpy as np
 import pytest
 
-from benchmarks.cases.fracture_cases import E_FACE, T_FACE, WIDTH, scene
-from sandwich.beam import solve
+from benchmarks.cases.fracture_cases import WIDTH
+from benchmarks.cases.growth_cases import GC, cantilever, onset_slope
 from sandwich.growth import grow, onset_rows
-from sandwich.scene import Growth, Toughness
-
-GC = 1e-5  # N/mm, the same in both modes: the onset does not depend on the mode mix (small:
-# the face deflects by at most 0.14 mm at its onsets, a rotation of 0.2 %, so that the nonlinear
-# path is the linear response the closed forms hold for)
-
-
-def _cantilever(**growth):
-    sc = scene([("top", 0.0, 1.0)], a=40.0, until=0.5, core=1)
-    d = dataclasses.replace(sc.debonds[0], toughness=Toughness(GC, GC), growth=Growth(**growth))
-    return dataclasses.replace(sc, debonds=(d,))
+from sandwich.beam import solve
 
 
 @pytest.fixture(scope="module")
 def envelope():
-    sol = grow(_cantilever(step=10.0, max_length=80.0), solve)
+    sol = grow(cantilever(step=10.0, max_length=80.0), solve)
     assert sol.converged, sol.message
     return onset_rows(sol.history)
 
@@ -43,7 +31,7 @@ def test_onsets_follow_the_closed_form_slope_of_one_over_the_load(envelope):
     assert list(a) == [40.0, 50.0, 60.0, 70.0, 80.0]
     inv = 1.0 / np.array([r.load_factor for r in envelope])
     slope = np.polyfit(a, inv, 1)[0]
-    exact = np.sqrt(6.0 / (GC * WIDTH**2 * E_FACE * T_FACE**3))
+    exact = onset_slope()
     assert slope == pytest.approx(exact, rel=0.02)
     # with the closed-form slope and the one root-rotation length χ t that fits best, every
     # onset load is within the 1 % of the beam's G (docs/fracture.md) of the closed form

@@ -1,0 +1,31 @@
+"""Growing-debond scenes with closed-form checks, shared by the growth tests and benchmarks.
+
+The face cantilever of :mod:`benchmarks.cases.fracture_cases` (an end force on the top face at
+an open mouth at x = 0, the tip at a, faces clamped at x = L) with a toughness and growth:
+beam theory with a root rotation gives G = 6 P² (a + χ t)² / (b² E t³), χ independent of a, so
+the onset load of each length is λ_c = √(G_c b² E t³ / 6) / (a + χ t): 1/λ_c is linear in a
+with the slope √(6 / (G_c b² E t³)) (:func:`onset_slope`), whatever χ.
+"""
+
+import dataclasses
+
+from benchmarks.cases.fracture_cases import E_FACE, T_FACE, WIDTH, scene
+from sandwich.scene import Growth, Toughness
+
+#: N/mm, the same in both modes (the onset does not depend on the mode mix); small, so that the
+#: face deflects by at most 0.14 mm at its onsets up to 80 mm (a rotation of 0.2 %) and the
+#: nonlinear path is the linear response the closed form holds for
+GC = 1e-5
+
+
+def cantilever(step=10.0, max_length=80.0, a=40.0, gc=GC, until=0.5):
+    """The face cantilever, debond [0, a], grown by ``step`` up to ``max_length`` (mm)."""
+    sc = scene([("top", 0.0, 1.0)], a=a, until=until, core=1)
+    d = dataclasses.replace(sc.debonds[0], toughness=Toughness(gc, gc),
+                            growth=Growth(step, max_length))
+    return dataclasses.replace(sc, debonds=(d,))
+
+
+def onset_slope(gc=GC):
+    """d(1/λ_c)/da of the face cantilever (1/(N mm)): √(6 / (G_c b² E t³))."""
+    return (6.0 / (gc * WIDTH**2 * E_FACE * T_FACE**3)) ** 0.5
