@@ -15,8 +15,8 @@ import pytest
 
 from benchmarks.cases.fracture_cases import WIDTH
 from benchmarks.cases.growth_cases import GC, cantilever, onset_slope
-from sandwich.growth import grow, onset_rows
 from sandwich.beam import solve
+from sandwich.growth import grow, onset_rows
 
 
 @pytest.fixture(scope="module")

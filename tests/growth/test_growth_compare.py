@@ -9,8 +9,8 @@ import csv
 
 import pytest
 
-from sandwich.compare import compare
 from benchmarks.cases.growth_cases import cantilever
+from sandwich.compare import compare
 
 pytestmark = pytest.mark.dolfinx
 
