@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sandwich.fracture import growth_onset, ill_conditioned_releases, missing_releases
-from sandwich.growth import final_scene, grow, growing
+from sandwich.growth import final_scene, grow, growing, growth_summary, onset_rows
 from sandwich.models.registry import get_model
 from sandwich.results import (
     InterruptedSolve,
@@ -112,8 +112,11 @@ def _partial(model: str, scene: Scene, states: list[StepRecord], seconds: float)
     solution = Solution(model, scene.name, list(states), [], False,
                         f"interrupted{last}: the converged steps are kept (no profiles)", [],
                         seconds, 0)
-    onset = growth_onset(scene, solution.history)  # debonds with a toughness, up to here
-    if onset:
+    if growing(scene):  # the onsets of the lengths grown so far
+        solution.extra["debond_growth"] = growth_summary(
+            scene, solution.history, len(onset_rows(solution.history)) - 1,
+            f"interrupted{last}")
+    elif onset := growth_onset(scene, solution.history):  # debonds with a toughness
         solution.extra["debond_growth"] = onset
     empty = missing_releases(solution.history)
     if empty:

@@ -42,7 +42,7 @@ AXIS_KEYS = ("name", "path", "derived", "values", "range", "logrange", "scale", 
 REPORT_KEYS = ("quantity", "reference", "threshold")
 QUANTITIES = ("capacity", "first_limit_load", "load_at_until", "initial_stiffness",
               "peak_sigma_zz", "peak_sigma_zz_5mm", "peak_tau_core", "peak_tau_core_5mm",
-              "contact_length")
+              "contact_length", "first_growth_load", "residual_strength")
 MAX_CASES = 20_000
 MAX_AXIS_VALUES = 10_000
 MAX_SHOWN = 12  # refused cases listed one per line, the rest counted

@@ -8,7 +8,11 @@ deflections are the scene's ``until`` probe (the first probe if it has none), in
   bifurcation the model reports along the path (empty when none before the end);
 - ``load_at_until``: λ at the end of a path that reached its target (empty otherwise);
 - ``capacity``: ``first_limit_load`` if there is one, else ``load_at_until`` (a lower bound of the
-  buckling load: the panel did not buckle before the target);
+  buckling load: the panel did not buckle before the target); in a scene that grows its
+  debonds, the ``residual_strength``;
+- ``first_growth_load`` / ``residual_strength``: of a scene that grows its debonds
+  (:mod:`sandwich.growth.envelope`; empty otherwise, and the residual strength empty where no
+  debond grew);
 - ``peak_sigma_zz`` (either interface) and ``peak_tau_core`` at the last profile (the last
   converged step), raw and averaged over 5 mm (:func:`sandwich.compare.profiles.peak`, the window
   the
@@ -105,6 +109,13 @@ def case_metrics(scene: Scene, sol: Solution) -> dict[str, object]:
     out["first_limit_w"] = (_finite(first.probes.get(probe)) if first and probe else None)
     out["load_at_until"] = _finite(sol.final_load_factor) if sol.converged and hist else None
     out["capacity"] = out["first_limit_load"] if first else out["load_at_until"]
+    growth = sol.extra.get("debond_growth")
+    grown = isinstance(growth, dict) and "method" in growth
+    out["first_growth_load"] = _finite(growth["first_growth_load"]) if grown else None
+    out["residual_strength"] = _finite(growth["residual_strength"]) if grown else None
+    if grown:  # the history is the growth envelope: no path to a target
+        out["load_at_until"] = None
+        out["capacity"] = out["residual_strength"]
     out["peak_sigma_zz"] = _signed_peak(sol, ("sigma_zz_top", "sigma_zz_bottom"), 0.0)
     out["peak_sigma_zz_5mm"] = _signed_peak(sol, ("sigma_zz_top", "sigma_zz_bottom"), PEAK_WINDOW)
     out["peak_tau_core"] = _signed_peak(sol, ("tau_core",), 0.0)

@@ -19,11 +19,13 @@ from sandwich.studies.study_params import axis_label
 
 METRICS = ("initial_stiffness", "first_limit_kind", "first_limit_load", "first_limit_w",
            "load_at_until", "capacity", "peak_sigma_zz", "peak_sigma_zz_5mm", "peak_tau_core",
-           "peak_tau_core_5mm", "contact_length", "converged", "steps", "stop_reason",
+           "peak_tau_core_5mm", "contact_length", "first_growth_load", "residual_strength",
+           "converged", "steps", "stop_reason",
            "solve_seconds", "wall_seconds", "indicator")
 UNITS = {"capacity": "λ", "first_limit_load": "λ", "load_at_until": "λ",
          "initial_stiffness": "N/mm", "peak_sigma_zz": "MPa", "peak_sigma_zz_5mm": "MPa",
-         "peak_tau_core": "MPa", "peak_tau_core_5mm": "MPa", "contact_length": "mm"}
+         "peak_tau_core": "MPa", "peak_tau_core_5mm": "MPa", "contact_length": "mm",
+         "first_growth_load": "λ", "residual_strength": "λ"}
 
 
 def _num(v: Any) -> float | None:

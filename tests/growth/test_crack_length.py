@@ -172,3 +172,31 @@ def test_a_failing_path_keeps_the_stages_before_it():
     sol = grow(sc, solve)
     assert len(onset_rows(sol.history)) == 2
     assert not sol.converged and "the corrector diverged" in sol.message
+
+
+def test_an_interrupted_growth_run_keeps_its_onsets_and_tip_positions(tmp_path):
+    import csv
+    import json
+
+    from sandwich.models import run_model
+
+    sc = _scene(kind="linear", step=4.0, max_length=80.0)
+    ok = _stand_in(2, [])
+    count = []
+
+    def solve(scene, progress=None):
+        count.append(1)
+        if len(count) == 3:
+            raise KeyboardInterrupt
+        return ok(scene, progress)
+
+    with pytest.raises(KeyboardInterrupt):
+        run_model(sc, "beam", tmp_path / "out", solver=solve)
+    rows = list(csv.DictReader((tmp_path / "out" / "history.csv").open()))
+    assert [(float(r["tip_0_start"]), float(r["tip_0_end"])) for r in rows] == [
+        (130.0, 170.0), (126.0, 174.0)]
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["converged"] is False
+    growth = summary["debond_growth"]
+    assert growth["onsets"] == 2 and growth["debonds"]["0"]["to"] == [126.0, 174.0]
+    assert growth["first_growth_load"] == pytest.approx(float(rows[0]["load_factor"]))

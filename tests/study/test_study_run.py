@@ -220,3 +220,20 @@ def test_no_indicator_at_the_top_core_level():
     below = dataclasses.replace(top, beam_model=dataclasses.replace(
         top.beam_model, core=MAX_CORE_LEVEL - 1))
     assert study_case.linear_indicator(below) > 0  # one level above it still: measured
+
+
+def test_a_growth_study_reports_the_residual_strength_of_each_case(tmp_path, capsys):
+    """The residual strength over the initial debond length of the face cantilever (its onset
+    load falls with the length: the residual strength is the first onset load). Reference: the
+    closed-form slope of 1/λ_c over the length (benchmarks/cases/growth_cases.py), 2 %."""
+    from benchmarks.cases.growth_cases import onset_slope
+
+    code = main(["study", str(HERE / "growth.toml"), "--out", str(tmp_path), "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    rows = {float(r["a0"]): r for r in csv.DictReader((tmp_path / "growth.csv").open())}
+    strength = {a: float(r["residual_strength"]) for a, r in rows.items()}
+    assert set(strength) == {40.0, 50.0}
+    assert all(float(rows[a]["first_growth_load"]) == strength[a] for a in rows)
+    slope = (1 / strength[50.0] - 1 / strength[40.0]) / 10.0
+    assert slope == pytest.approx(onset_slope(), rel=0.02)
+    assert float(rows[50.0]["knockdown"]) < 1.0
