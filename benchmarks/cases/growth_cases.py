@@ -29,3 +29,38 @@ def cantilever(step=10.0, max_length=80.0, a=40.0, gc=GC, until=0.5):
 def onset_slope(gc=GC):
     """d(1/λ_c)/da of the face cantilever (1/(N mm)): √(6 / (G_c b² E t³))."""
     return (6.0 / (gc * WIDTH**2 * E_FACE * T_FACE**3)) ** 0.5
+
+
+def shipped(name, toughness, step=4.0, max_length=80.0, debond=0, level=None):
+    """A shipped scene (``scenes/<name>.toml``) with debond ``debond`` tough and growing.
+
+    ``toughness`` is (GIc, GIIc) in N/mm (eta 2); ``level`` sets the 2D mesh level.
+    """
+    from benchmarks.provenance import ROOT
+    from sandwich.scene_file import load_scene
+
+    sc = load_scene(ROOT / "scenes" / f"{name}.toml")
+    d = dataclasses.replace(sc.debonds[debond], toughness=Toughness(*toughness),
+                            growth=Growth(step, max_length))
+    sc = dataclasses.replace(sc, debonds=tuple(d if i == debond else o
+                                               for i, o in enumerate(sc.debonds)))
+    if level is not None:
+        sc = dataclasses.replace(sc, reference2d=dataclasses.replace(sc.reference2d,
+                                                                     level=level))
+    return sc
+
+
+#: The growth benchmark's cases: (scene builder, what it shows). Toughnesses are chosen so that
+#: each debond grows well inside its scene's load range (an interface weaker than a real foam
+#: core's): fig. 5's mixed-mode tips below the face's buckling, c3's clamp debond once its face
+#: has buckled away (mode I).
+CASES = {
+    "cantilever": (lambda level: dataclasses.replace(
+        cantilever(), reference2d=dataclasses.replace(cantilever().reference2d, level=level)),
+        "face cantilever, end force at the open mouth (closed form: 1/λ_c linear in a)"),
+    "fig5": (lambda level: shipped("paper-fig5-top-debond-40-load-top", (0.004, 0.008),
+                                   level=level),
+             "fig. 5, 40 mm top debond under the pad, both tips, GIc 0.004, GIIc 0.008 N/mm"),
+    "c3": (lambda level: shipped("paper-fig7-cantilever-c3", (0.1, 0.3), level=level),
+           "c3 cantilever, bottom debond at the clamp, its tip, GIc 0.1, GIIc 0.3 N/mm"),
+}
