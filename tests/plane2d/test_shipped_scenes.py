@@ -91,8 +91,11 @@ def test_shipped_scene_coarse_full_path(name):
     "measured 2026-12-07 on the coarse mesh with elements of aspect <= 5 over the debond: the "
     "path crawls up to the snap maximum (lambda 1982.73 at w_bottom_mid = -9.577 mm, the "
     "maximum located before at 1983.07) and stops there; its probe rescues, also with the "
-    "largest probe step of the path (1.74 mm), do not converge past it. On the coarser debond "
-    "mesh (aspect 20) a rescue passed it (docs/reference2d.md)"))
+    "largest probe step of the path (1.74 mm), do not converge past it: the lip nodes next to "
+    "both crack tips release at the maximum and Newton cycles between the two contact sets; "
+    "whether a rescue lands on the snapped branch is chance (at k 22000 instead of 21000 it "
+    "does, 2151.29 at -15 mm; on the coarser debond mesh, aspect 20, a rescue passed it too; "
+    "docs/contact.md, 'Past a snap')"))
 def test_fig6_full_path_passes_the_face_snap_maximum_without_crushing_the_core():
     """fig6: a load maximum λ ≈ 1983 at w_bottom_mid ≈ −9.6 mm, passed by the path follower's
     probe rescue (docs/solver.md) to −15 mm. It was read as the core's corner above the pin
