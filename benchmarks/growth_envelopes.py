@@ -11,6 +11,12 @@ closed form √(6 / (G_c b² E t³)).
 
     python -m benchmarks.growth_envelopes                     # every case, 2D coarse
     python -m benchmarks.growth_envelopes --cases fig5 --level medium
+    python -m benchmarks.growth_envelopes --objectivity --cases fig5   # beam only
+
+``--objectivity`` instead runs the beam alone on each case at its defaults, with the growth
+step halved, and with twice the elements, and writes
+``benchmarks/results/growth/growth_objectivity.{csv,md}``: how much the first growth load and
+the residual strength move (the discretisation of the growth and of the beam).
 
 Writes ``benchmarks/results/growth/growth_envelopes.{csv,md}``; a run of some cases replaces
 their rows and keeps the others (each row says when and at which 2D level it was measured).
@@ -97,11 +103,89 @@ def write_md(rows: list[dict]) -> None:
     (OUT / "growth_envelopes.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
+OBJ_FIELDS = ["measured", "case", "variant", "step_mm", "elements", "lengths",
+              "first_growth_N", "residual_strength_N", "first_growth_change",
+              "residual_strength_change", "seconds"]
+
+
+def objectivity(case: str) -> list[dict]:
+    """The beam's growth on ``case`` at its defaults, half the growth step, twice the elements."""
+    import dataclasses
+
+    from sandwich.beam import solve
+    from sandwich.compare.compare import total_force
+    from sandwich.growth import grow
+
+    build, _ = CASES[case]
+    base = build("coarse")
+    i = next(k for k, d in enumerate(base.debonds) if d.growth is not None)
+    d = base.debonds[i]
+
+    def with_debond(sc, new):
+        return dataclasses.replace(sc, debonds=tuple(new if k == i else o
+                                                     for k, o in enumerate(sc.debonds)))
+
+    half = with_debond(base, dataclasses.replace(d, growth=dataclasses.replace(
+        d.growth, step=0.5 * d.growth.step)))
+    finer = dataclasses.replace(base, beam_model=dataclasses.replace(
+        base.beam_model, elements=2 * base.beam_model.elements))
+    out, first = [], None
+    for name, sc in (("defaults", base), ("half step", half), ("twice the elements", finer)):
+        t = time.perf_counter()
+        sol = grow(sc, solve)
+        g = sol.extra["debond_growth"]
+        scale = total_force(sc)
+        row = {"measured": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "case": case,
+               "variant": name, "step_mm": sc.debonds[i].growth.step,
+               "elements": sc.beam_model.elements, "lengths": g["onsets"],
+               "first_growth_N": scale * g["first_growth_load"],
+               "residual_strength_N": scale * g["residual_strength"],
+               "seconds": f"{time.perf_counter() - t:.1f}"}
+        if first is None:
+            first = row
+        for k in ("first_growth", "residual_strength"):
+            row[f"{k}_change"] = f"{row[f'{k}_N'] / first[f'{k}_N'] - 1:+.4f}"
+        out.append(row)
+        print(row, flush=True)
+    return out
+
+
+def write_objectivity(rows: list[dict]) -> None:
+    lines = [
+        "# Growth: the beam's first growth load and residual strength under a halved growth "
+        "step and twice the elements (`benchmarks/growth_envelopes.py --objectivity`)",
+        "",
+        f"Machine: {machine()}; each row's `measured` column is its UTC time. Beam at the "
+        "scene's defaults otherwise; changes are relative to the defaults row of the case.",
+        "",
+        "| case | variant | step (mm) | elements | lengths | first growth (N) | change | "
+        "residual strength (N) | change | seconds | measured |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['variant']} | {r['step_mm']} | {r['elements']} | "
+                     f"{r['lengths']} | {float(r['first_growth_N']):.5g} | "
+                     f"{r['first_growth_change']} | {float(r['residual_strength_N']):.5g} | "
+                     f"{r['residual_strength_change']} | {r['seconds']} | {r['measured']} |")
+    (OUT / "growth_objectivity.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     p.add_argument("--level", default="coarse", choices=("coarse", "medium", "fine"))
+    p.add_argument("--objectivity", action="store_true",
+                   help="the beam alone: growth step halved, elements doubled")
     args = p.parse_args()
+    if args.objectivity:
+        path = OUT / "growth_objectivity.csv"
+        old = list(csv.DictReader(path.open())) if path.is_file() else []
+        kept = [r for r in old if r["case"] not in args.cases]
+        rows = kept + [r for case in args.cases for r in objectivity(case)]
+        rows.sort(key=lambda r: list(CASES).index(r["case"]))
+        write_rows(path, OBJ_FIELDS, rows)
+        write_objectivity(rows)
+        return
     path = OUT / "growth_envelopes.csv"
     old = list(csv.DictReader(path.open())) if path.is_file() else []
     rows = {(r["case"], r["level_2d"]): r for r in old}

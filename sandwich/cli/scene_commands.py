@@ -156,9 +156,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
                  else f"at step {lp.step}")
         say(args, f"  {lp.kind} {where}: load factor {lp.load_factor:.6g}")
     growth = sol.extra.get("debond_growth")
-    if isinstance(growth, dict) and "method" in growth:
+    grown = isinstance(growth, dict) and "method" in growth
+    if grown:
         say(args, growth_line(growth))
-    say(args, accuracy_line(args.model, sol))
+    say(args, accuracy_line(f"{args.model} (the last length's path)" if grown else args.model,
+                            sol))
     say(args, f"results in {out}/ ({written_files(out)})")
     for w in sol.warnings if mpi_rank() == 0 else ():
         print(f"WARNING: {w}", file=sys.stderr)

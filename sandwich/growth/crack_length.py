@@ -173,6 +173,8 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
         f"growth by crack-length control: {stopped}", [], time.perf_counter() - t0,
         base.dofs if base else 0, fields=fields,
         warnings=(list(base.warnings) if base else []) + warnings)
+    if base is not None:  # what the last path says of itself (the beam's core levels, …)
+        out.extra.update({k: v for k, v in base.extra.items() if k != "debond_growth"})
     out.extra["debond_growth"] = growth_summary(scene, rows, stage, stopped)
     return out
 
