@@ -97,8 +97,8 @@ def write_md(rows: list[dict]) -> None:
             f"{r['lengths_2d']} | {n(r['first_growth_beam_N'])} / {n(r['first_growth_2d_N'])} | "
             f"{n(r['first_growth_ratio'], '{:.4f}')} | {n(r['residual_strength_beam_N'])} / "
             f"{n(r['residual_strength_2d_N'])} | {n(r['residual_strength_ratio'], '{:.4f}')} | "
-            f"{n(r['onset_slope_beam_over_closed'], '{:.4f}')}, "
-            f"{n(r['onset_slope_2d_over_closed'], '{:.4f}')} | {r['seconds_beam']} / "
+            f"{n(r.get('onset_slope_beam_over_closed'), '{:.4f}')}, "
+            f"{n(r.get('onset_slope_2d_over_closed'), '{:.4f}')} | {r['seconds_beam']} / "
             f"{r['seconds_2d']} | {r['speedup'] or '—'} | {r['measured']} |")
     (OUT / "growth_envelopes.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 

@@ -31,7 +31,14 @@ from collections.abc import Callable
 
 from sandwich.growth.crossing import Crossing, criterion_ratio, first_crossing
 from sandwich.growth.envelope import growth_summary
-from sandwich.growth.locate import ONSET_RTOL, located, needs_solving
+from sandwich.growth.locate import (
+    ONSET_RTOL,
+    located,
+    needs_solving,
+    predicted_target,
+    target_quantity,
+    with_target,
+)
 from sandwich.results import PathNote, ProgressItem, Solution, StepRecord
 from sandwich.results.fracture import column_names
 from sandwich.scene import Debond, Scene
@@ -116,6 +123,7 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
     stopped = ""
     failed: str | None = None
     warnings: list[str] = []
+    onsets: list[float] = []  # the until quantity at each onset (where the next is looked for)
     limit = sum(math.ceil(max(room(scene, i, t), 0.0) / scene.debonds[i].growth.step) + 1
                 for i, d in enumerate(scene.debonds) if d.growth is not None
                 for t in open_tips(scene, i))
@@ -123,14 +131,14 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
         say(PathNote(f"growth stage {stage}: " + _lengths(current), restart=False))
         inner = None  # a stage's own path states are not the growth run's: not streamed
         try:
-            solution = solve(current, progress=inner)
+            solution, first = _stage(current, solve, predicted_target(current, onsets))
         except KeyboardInterrupt:
             raise KeyboardInterrupt("interrupted during a growth stage") from None
         except Exception as exc:  # a failing path ends the growth; the kept stages stay
             failed = f"{type(exc).__name__}: {exc}"
             stopped = f"the path at stage {stage} ({_lengths(current)}) failed: {failed}"
             break
-        first, there = _first(current, solution.history), None
+        there = None
         if first is not None and needs_solving(current, first, solution.history):
             first, there = located(current, solve, first, solution.history, inner)
             if there is None:
@@ -151,6 +159,9 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
         if stage == 0:
             rows.extend(_record(r, current, stage) for r in solution.history[: first.index + 1])
         tips = _together(current, first, solution.history, there is not None)
+        onsets.append(target_quantity(current)(solution.history[-1]) if there is not None
+                      else first.probes.get(current.analysis.until_probe, first.load_factor)
+                      if current.analysis.until_probe is not None else first.load_factor)
         rows.append(_crossing_row(first, tips, solution.history, current, stage, rows,
                                  there is not None))
         say(rows[-1])
@@ -191,6 +202,23 @@ def final_scene(scene: Scene, solution: Solution) -> Scene:
                                     end=float(last[tip_column(i, "end")]))
         debonds.append(d)
     return dataclasses.replace(scene, debonds=tuple(debonds))
+
+
+def _stage(scene: Scene, solve: Solve, target: float | None
+           ) -> tuple[Solution, Crossing | None]:
+    """One length's path and its first crossing: up to ``target`` first, then to the end.
+
+    ``target`` (the ``until`` quantity, :func:`~sandwich.growth.locate.predicted_target`)
+    shortens the path where the onset is expected; where no tip reaches G_c by then, the path
+    is solved to the scene's own target.
+    """
+    if target is not None:
+        solution = solve(with_target(scene, target))
+        first = _first(scene, solution.history)
+        if first is not None:
+            return solution, first
+    solution = solve(scene)
+    return solution, _first(scene, solution.history)
 
 
 def _first(scene: Scene, history: list[StepRecord]) -> Crossing | None:

@@ -8,6 +8,10 @@ value, or the load factor where the scene stops on it), so that the path ends on
 equilibrium there: the path follower hits a target exactly. The target is updated by regula
 falsi on r between the two states that bracket 1 until r is within :data:`ONSET_RTOL` of 1
 (G within twice that of G_c), at most :data:`MAX_SOLVES` times.
+
+A length after the first is solved first to a target a little beyond its onset extrapolated
+from the lengths before (:func:`predicted_target`): a path need not go on to the scene's end to
+find where its debond grows.
 """
 
 from __future__ import annotations
@@ -30,6 +34,42 @@ ONSET_RTOL = 2.5e-3
 #: crossing's load) is kept as interpolated: its error is second order in that step
 NARROW_STEP = 0.01
 MAX_SOLVES = 8
+#: A length's path first goes this much beyond the onset extrapolated from the lengths before
+#: (relative, in the ``until`` quantity), and on to the scene's target only where no tip
+#: reaches G_c by then
+PREDICT_MARGIN = 0.25
+
+
+def target_quantity(scene: Scene) -> Callable[[StepRecord], float]:
+    """The quantity the scene stops on, of a state: its ``until`` probe, else the load."""
+    name = scene.analysis.until_probe
+    return (lambda r: r.probes[name]) if name is not None else (lambda r: r.load_factor)
+
+
+def with_target(scene: Scene, value: float) -> Scene:
+    """``scene`` stopping where its ``until`` quantity (probe, else load factor) is ``value``."""
+    a = scene.analysis
+    a = (dataclasses.replace(a, until_value=value) if a.until_probe is not None
+         else dataclasses.replace(a, until_load_factor=value))
+    return dataclasses.replace(scene, analysis=a)
+
+
+def predicted_target(scene: Scene, onsets: list[float]) -> float | None:
+    """Where a path need go to meet the next length's onset: ``None`` for the scene's end.
+
+    ``onsets`` are the ``until`` quantity at the onsets so far; the next is extrapolated
+    linearly from the last two (the last alone after one) and the path asked to go
+    :data:`PREDICT_MARGIN` beyond it, never beyond the scene's own target.
+    """
+    end = (scene.analysis.until_value if scene.analysis.until_probe is not None
+           else scene.analysis.until_load_factor)
+    if not onsets or end is None:
+        return None
+    guess = onsets[-1] if len(onsets) == 1 else 2.0 * onsets[-1] - onsets[-2]
+    if guess * end <= 0.0:  # not on the way to the scene's target
+        return None
+    value = guess * (1.0 + PREDICT_MARGIN)
+    return None if abs(value) >= abs(end) else value
 
 
 def needs_solving(scene: Scene, c: Crossing, history: list[StepRecord]) -> bool:
@@ -67,8 +107,7 @@ def located(scene: Scene, solve: Callable[..., Solution], c: Crossing,
     Returns ``(c, None)`` where the path cannot be stopped there (a re-solve that does not
     reach its target) or r does not come within :data:`ONSET_RTOL` of 1.
     """
-    name = scene.analysis.until_probe
-    quantity = (lambda r: r.probes[name]) if name is not None else (lambda r: r.load_factor)
+    quantity = target_quantity(scene)
     t = scene.debonds[c.debond].toughness
     lo, hi = history[c.index], history[c.index + 1]
     q_lo, q_hi = quantity(lo), quantity(hi)
@@ -79,10 +118,7 @@ def located(scene: Scene, solve: Callable[..., Solution], c: Crossing,
     side = 0  # Illinois: which end was kept last time (halve its r-distance if kept twice)
     for _ in range(MAX_SOLVES):
         target = q_lo + (1.0 - r_lo) / (r_hi - r_lo) * (q_hi - q_lo)
-        analysis = (dataclasses.replace(scene.analysis, until_value=target)
-                    if name is not None else
-                    dataclasses.replace(scene.analysis, until_load_factor=target))
-        solution = solve(dataclasses.replace(scene, analysis=analysis), progress=progress)
+        solution = solve(with_target(scene, target), progress=progress)
         if not solution.converged or not solution.history:
             return c, None
         end = solution.history[-1]
