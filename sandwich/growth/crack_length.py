@@ -148,6 +148,11 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
             else:
                 solution = there
         last_solution = solution
+        if first is None and not _carries_g(current, solution.history):
+            failed = solution.extra.get("G_warning") or "no G at the growing tips"
+            stopped = (f"the path at stage {stage} ({_lengths(current)}) gives no G at the "
+                       f"growing tips, so their growth cannot be judged: {failed}")
+            break
         if first is None:
             end = solution.history[-1].load_factor if solution.history else 0.0
             why = "reached its end" if solution.converged else f"stopped ({solution.message})"
@@ -202,6 +207,13 @@ def final_scene(scene: Scene, solution: Solution) -> Scene:
                                     end=float(last[tip_column(i, "end")]))
         debonds.append(d)
     return dataclasses.replace(scene, debonds=tuple(debonds))
+
+
+def _carries_g(scene: Scene, history: list[StepRecord]) -> bool:
+    """Whether some state of ``history`` has G at a growing tip of ``scene``."""
+    names = [column_names(i, t)[0] for i, d in enumerate(scene.debonds) if d.growth is not None
+             for t in open_tips(scene, i)]
+    return any(r.extra.get(n) is not None for r in history for n in names)
 
 
 def _stage(scene: Scene, solve: Solve, target: float | None

@@ -200,3 +200,20 @@ def test_an_interrupted_growth_run_keeps_its_onsets_and_tip_positions(tmp_path):
     growth = summary["debond_growth"]
     assert growth["onsets"] == 2 and growth["debonds"]["0"]["to"] == [126.0, 174.0]
     assert growth["first_growth_load"] == pytest.approx(float(rows[0]["load_factor"]))
+
+
+def test_a_path_without_g_at_the_tips_stops_the_growth_and_says_why():
+    sc = _scene(kind="linear", step=4.0)
+
+    def solve(scene, progress=None):
+        rows = [StepRecord(j, lam, {"w": 0.0}, 1, {"G_0_end": None, "GI_0_end": None,
+                                                    "GII_0_end": None})
+                for j, lam in enumerate((0.0, 400.0))]
+        sol = Solution("stand-in", scene.name, rows, [], True, "reached", [], 0.0, 10)
+        sol.extra["G_warning"] = "linear analysis: the lips are tied"
+        return sol
+
+    sol = grow(sc, solve)
+    assert not sol.converged
+    assert "gives no G" in sol.message and "lips are tied" in sol.message
+    assert sol.extra["debond_growth"]["first_growth_load"] is None
