@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 import time
 
 import numpy as np
@@ -37,7 +38,7 @@ OUT = RESULTS / "growth"
 FIELDS = ["measured", "case", "level_2d", "lengths_beam", "lengths_2d", "first_growth_beam_N",
           "first_growth_2d_N", "first_growth_ratio", "residual_strength_beam_N",
           "residual_strength_2d_N", "residual_strength_ratio", "onset_slope_beam_over_closed",
-          "onset_slope_2d_over_closed", "seconds_beam", "seconds_2d", "speedup"]
+          "onset_slope_2d_over_closed", "seconds_beam", "seconds_2d", "speedup", "load"]
 
 
 def measure(case: str, level: str) -> dict:
@@ -66,6 +67,7 @@ def measure(case: str, level: str) -> dict:
     beam = rows.get("beam", {})
     row["first_growth_ratio"] = beam.get("first_growth_load_over_2d", "")
     row["residual_strength_ratio"] = beam.get("residual_strength_over_2d", "")
+    row["load"] = f"{os.getloadavg()[0]:.2f}"  # > 1.2 or so: other jobs shared the 2 cores
     if row["seconds_beam"] and row["seconds_2d"]:
         row["speedup"] = f"{float(row['seconds_2d']) / float(row['seconds_beam']):.1f}"
     return row
@@ -79,13 +81,15 @@ def write_md(rows: list[dict]) -> None:
         f"Machine: {machine()}. Each row's `measured` column is its UTC time; the 2D level is "
         "its own column. Loads in N; ratios beam / 2D; seconds are each model's whole growth "
         "run (every length's path, and the paths stopped on an onset), one after the other in "
-        "one process; speed-up = 2D seconds / beam seconds. Figures and `growth.csv` per case "
+        "one process; speed-up = 2D seconds / beam seconds; load = the 1-minute load average "
+        "at the end of the case (above ≈ 1.2 other jobs shared the 2 cores, and the times "
+        "are not a clean comparison; — : not recorded). Figures and `growth.csv` per case "
         "in `benchmarks/results/growth/<case>/`.",
         "",
         "| case | what | 2D level | lengths beam / 2D | first growth beam / 2D (N) | ratio | "
         "residual strength beam / 2D (N) | ratio | 1/λ_c slope / closed form beam, 2D | "
-        "seconds beam / 2D | speed-up | measured |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "seconds beam / 2D | speed-up | load | measured |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
 
     def n(v, f="{:.5g}"):
@@ -99,7 +103,8 @@ def write_md(rows: list[dict]) -> None:
             f"{n(r['residual_strength_2d_N'])} | {n(r['residual_strength_ratio'], '{:.4f}')} | "
             f"{n(r.get('onset_slope_beam_over_closed'), '{:.4f}')}, "
             f"{n(r.get('onset_slope_2d_over_closed'), '{:.4f}')} | {r['seconds_beam']} / "
-            f"{r['seconds_2d']} | {r['speedup'] or '—'} | {r['measured']} |")
+            f"{r['seconds_2d']} | {r['speedup'] or '—'} | {r.get('load') or '—'} | "
+            f"{r['measured']} |")
     (OUT / "growth_envelopes.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
