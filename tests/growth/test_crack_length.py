@@ -217,3 +217,38 @@ def test_a_path_without_g_at_the_tips_stops_the_growth_and_says_why():
     assert not sol.converged
     assert "gives no G" in sol.message and "lips are tied" in sol.message
     assert sol.extra["debond_growth"]["first_growth_load"] is None
+
+
+def test_a_load_maximum_before_the_onset_is_the_residual_strength():
+    # every length's path rises to λ 300 and falls again while G keeps growing with the
+    # probe: the onset lies past the maximum, which the panel must carry first
+    sc = _scene(kind="nonlinear", step=4.0, max_length=44.0, until=1000.0)
+    sc = dataclasses.replace(sc, analysis=dataclasses.replace(
+        sc.analysis, until_load_factor=None, until_probe="w", until_value=-10.0))
+
+    def solve(scene, progress=None):
+        target = scene.analysis.until_value
+        w = [-0.5 * k for k in range(int(round(-target / 0.5)) + 1)]
+        if w[-1] != target:
+            w.append(target)
+        rows = []
+        for j, wj in enumerate(w):
+            lam = 300.0 - 30.0 * (wj + 3.0) ** 2 / 2.5  # maximum 300 at w = −3
+            g = 0.004 * wj**2 * scene.debonds[0].length / 40.0
+            rows.append(StepRecord(j, lam, {"w": wj}, 1,
+                                   {"G_0_end": g, "GI_0_end": g, "GII_0_end": 0.0}))
+        return Solution("stand-in", scene.name, rows, [], True, "reached", [], 0.0, 10)
+
+    sc = dataclasses.replace(sc, debonds=(dataclasses.replace(
+        sc.debonds[0], toughness=Toughness(0.1, 0.1), growth=Growth(4.0, 44.0)),))
+    sol = grow(sc, solve)
+    onsets = onset_rows(sol.history)
+    assert len(onsets) == 2
+    # onset where G = 0.1: w² = 25 · 40 / a, w = −5 at 40 mm, −4.77 at 44: past the maximum
+    assert onsets[1].probes["w"] == pytest.approx(-math.sqrt(25 * 40 / 44), rel=ONSET_RTOL)
+    for r in onsets:
+        assert r.load_factor < 0.9 * 300.0  # on the falling branch
+        assert r.extra["peak_load_factor"] == pytest.approx(300.0, rel=1e-12)
+    summary = sol.extra["debond_growth"]
+    assert summary["residual_strength"] == pytest.approx(300.0, rel=1e-12)
+    assert summary["first_growth_load"] == pytest.approx(onsets[0].load_factor)
