@@ -170,7 +170,7 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
         rows.append(_crossing_row(first, tips, solution.history, current, stage, rows,
                                  there is not None))
         say(rows[-1])
-        last_cut = first.index
+        last_cut = first.index + 1 if there is not None else first.index
         ahead = current
         for i, t in tips:
             ahead = advanced(ahead, i, t, current.debonds[i].growth.step)
@@ -323,18 +323,22 @@ def _tail(history: list[StepRecord], rows: list[StepRecord], scene: Scene) -> li
 
 
 def _last_frames(solution: Solution | None, cut: int | None, rows: list[StepRecord]):
-    """Profiles and fields of the last path at its last state before growth (or its end)."""
-    if solution is None or not rows:
+    """Profiles and fields of the last path at its onset (or its end), renumbered to the last row.
+
+    ``cut`` is the index of the onset state in the path (where it was solved for) or of the
+    state before it (interpolated); each kind of frame is taken at the latest step up to it that
+    has one (a model may write profiles only at some steps).
+    """
+    if solution is None or not rows or not solution.history:
         return [], []
-    steps = [r.step for r in solution.history[: None if cut is None else cut + 1]]
-    if not steps:
-        return [], []
-    keep = max(steps)
-    profiles = [dataclasses.replace(p, step=rows[-1].step) for p in solution.profiles
-                if p.step == keep]
-    fields = [dataclasses.replace(f, step=rows[-1].step) for f in solution.fields
-              if f.step == keep]
-    return profiles, fields
+    limit = solution.history[-1 if cut is None else cut].step
+
+    def latest(frames):
+        steps = [f.step for f in frames if f.step <= limit]
+        return ([dataclasses.replace(f, step=rows[-1].step) for f in frames
+                 if f.step == max(steps)] if steps else [])
+
+    return latest(solution.profiles), latest(solution.fields)
 
 
 def _lengths(scene: Scene) -> str:
