@@ -14,7 +14,8 @@ closed form √(6 / (G_c b² E t³)).
     python -m benchmarks.growth_envelopes --objectivity --cases fig5   # beam only
 
 ``--objectivity`` instead runs the beam alone on each case at its defaults, with the growth
-step halved, and with twice the elements, and writes
+step halved, with twice the elements, and at the fixed core levels 1 (the paper's element) and
+3 instead of ``auto``, and writes
 ``benchmarks/results/growth/growth_objectivity.{csv,md}``: how much the first growth load and
 the residual strength move (the discretisation of the growth and of the beam).
 
@@ -113,7 +114,11 @@ OBJ_FIELDS = ["measured", "case", "variant", "step_mm", "elements", "lengths",
               "residual_strength_change", "seconds"]
 
 
-def objectivity(case: str) -> list[dict]:
+VARIANTS = ("defaults", "half step", "twice the elements", "core level 1", "core level 3")
+
+
+def objectivity(case: str, variants: tuple[str, ...] = VARIANTS,
+                reference: dict | None = None) -> list[dict]:
     """The beam's growth on ``case`` at its defaults, half the growth step, twice the elements."""
     import dataclasses
 
@@ -134,8 +139,13 @@ def objectivity(case: str) -> list[dict]:
         d.growth, step=0.5 * d.growth.step)))
     finer = dataclasses.replace(base, beam_model=dataclasses.replace(
         base.beam_model, elements=2 * base.beam_model.elements))
-    out, first = [], None
-    for name, sc in (("defaults", base), ("half step", half), ("twice the elements", finer)):
+    fixed = {f"core level {k}": dataclasses.replace(base, beam_model=dataclasses.replace(
+        base.beam_model, core=k)) for k in (1, 3)}
+    out, first = [], reference
+    for name, sc in (("defaults", base), ("half step", half), ("twice the elements", finer),
+                     *fixed.items()):
+        if name not in variants:
+            continue
         t = time.perf_counter()
         sol = grow(sc, solve)
         g = sol.extra["debond_growth"]
@@ -161,7 +171,8 @@ def write_objectivity(rows: list[dict]) -> None:
         "step and twice the elements (`benchmarks/growth_envelopes.py --objectivity`)",
         "",
         f"Machine: {machine()}; each row's `measured` column is its UTC time. Beam at the "
-        "scene's defaults otherwise; changes are relative to the defaults row of the case.",
+        "scene's defaults otherwise (`core = \"auto\"`); changes are relative to the defaults "
+        "row of the case; seconds with the load of other jobs on the machine as it was.",
         "",
         "| case | variant | step (mm) | elements | lengths | first growth (N) | change | "
         "residual strength (N) | change | seconds | measured |",
@@ -180,14 +191,23 @@ def main() -> None:
     p.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     p.add_argument("--level", default="coarse", choices=("coarse", "medium", "fine"))
     p.add_argument("--objectivity", action="store_true",
-                   help="the beam alone: growth step halved, elements doubled")
+                   help="the beam alone: growth step halved, elements doubled, fixed levels")
+    p.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS,
+                   help="with --objectivity: which runs (default: all)")
     args = p.parse_args()
     if args.objectivity:
         path = OUT / "growth_objectivity.csv"
         old = list(csv.DictReader(path.open())) if path.is_file() else []
-        kept = [r for r in old if r["case"] not in args.cases]
-        rows = kept + [r for case in args.cases for r in objectivity(case)]
-        rows.sort(key=lambda r: list(CASES).index(r["case"]))
+        wanted = tuple(args.variants)
+        kept = [r for r in old if r["case"] not in args.cases or r["variant"] not in wanted]
+        rows = kept[:]
+        for case in args.cases:
+            ref = next((r for r in kept if r["case"] == case and r["variant"] == "defaults"),
+                       None)
+            if ref is not None:
+                ref = {k: float(ref[k]) for k in ("first_growth_N", "residual_strength_N")}
+            rows += objectivity(case, wanted, ref)
+        rows.sort(key=lambda r: (list(CASES).index(r["case"]), VARIANTS.index(r["variant"])))
         write_rows(path, OBJ_FIELDS, rows)
         write_objectivity(rows)
         return
