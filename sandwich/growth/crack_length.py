@@ -30,7 +30,7 @@ import time
 from collections.abc import Callable
 
 from sandwich.growth.crossing import Crossing, criterion_ratio, first_crossing
-from sandwich.growth.envelope import growth_summary
+from sandwich.growth.envelope import ONSET, growth_summary
 from sandwich.growth.locate import (
     ONSET_RTOL,
     located,
@@ -305,7 +305,7 @@ def _crossing_row(c: Crossing, tips: list[tuple[int, str]], history: list[StepRe
         if not at_end or own is c:
             extra.update(zip(column_names(i, t), (own.G, own.GI, own.GII), strict=True))
     extra |= {**tip_positions(scene), "stage": float(stage),
-             "Gc": c.Gc, "peak_load_factor": c.peak_load,
+             ONSET: 1.0, "Gc": c.Gc, "peak_load_factor": c.peak_load,
              "onset_bracket": c.bracket[1] - c.bracket[0]}
     step = rows[-1].step + 1 if rows else 0
     return StepRecord(step, c.load_factor, dict(c.probes), history[c.index].iterations, extra)

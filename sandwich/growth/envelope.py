@@ -25,9 +25,12 @@ METHOD = ("crack-length control: each tip advances by the debond's growth step a
           "where its G (virtual crack closure) reaches G_c")
 
 
+ONSET = "onset"  # history column: 1 on an onset state, 0 (or absent) on a path state
+
+
 def onset_rows(rows: list[StepRecord]) -> list[StepRecord]:
-    """The envelope: the rows that are onset states (they carry ``Gc``)."""
-    return [r for r in rows if "Gc" in r.extra]
+    """The envelope: the rows that are onset states (``onset`` = 1, also when read back)."""
+    return [r for r in rows if r.extra.get(ONSET) == 1.0]
 
 
 def growth_summary(scene: Scene, rows: list[StepRecord], stages: int,

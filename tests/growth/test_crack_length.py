@@ -252,3 +252,14 @@ def test_a_load_maximum_before_the_onset_is_the_residual_strength():
     summary = sol.extra["debond_growth"]
     assert summary["residual_strength"] == pytest.approx(300.0, rel=1e-12)
     assert summary["first_growth_load"] == pytest.approx(onsets[0].load_factor)
+
+
+def test_the_envelope_is_found_again_in_a_result_folder_read_back(tmp_path):
+    from sandwich.models import run_model
+    from sandwich.results import load_result
+
+    sc = _scene(kind="linear", step=4.0, max_length=56.0)
+    sol = run_model(sc, "beam", tmp_path / "out", solver=_stand_in(2, []))
+    back = load_result(tmp_path / "out")
+    assert [r.step for r in onset_rows(back.history)] == [r.step for r in onset_rows(sol.history)]
+    assert len(onset_rows(back.history)) == 3 < len(back.history)  # 40, 48, 56 mm
