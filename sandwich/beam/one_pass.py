@@ -1,7 +1,7 @@
 """``auto`` core levels in one pass: checked and raised along the path, never rerun.
 
 The path starts at the linear step's levels (:mod:`sandwich.beam.core_choice`). At a few of its
-converged states — a quarter, half and three quarters of the way to the target
+converged states — a tenth, a quarter, half and three quarters of the way to the target
 (``CHECK_FRACTIONS``), after a located critical point (the state before it) and at the target —
 :class:`OnePass`, the path follower's ``refine`` hook (:mod:`sandwich.solver.path.switching`),
 estimates the error of the answer there (:meth:`OnePass.estimate`): the state re-converged by
@@ -15,7 +15,8 @@ Within the tolerance, the path goes on. Beyond it, the levels are raised where t
 (:func:`~sandwich.beam.core_controller.raised_levels`: every debonded stretch and load patch and
 the residual's share, up to ``max_core_level``), the state is re-converged there and checked
 again, and the path goes on at the raised levels from the last state a check kept (the steps
-after it are taken again), so every state keeps the accuracy its check found. A raised model
+after it are taken again; the first raise takes it again from its first step), so every state
+keeps the accuracy its check found. A raised model
 with no equilibrium near the checked state, or with another inertia there, has left this path's
 branch: the raise goes back to an earlier state. The estimate at the target is the run's, with
 the element length's share added there: the state re-converged with every element split in two
@@ -44,8 +45,9 @@ from sandwich.solver.path import Refinement
 from sandwich.solver.system import inner_product
 
 #: Fractions of the way to the target (the until probe's value, else the load) at which the
-#: levels are checked besides critical points and the target itself.
-CHECK_FRACTIONS = (0.25, 0.5, 0.75)
+#: levels are checked besides critical points and the target itself; the first raise takes the
+#: path again from its first step, so the first check comes early.
+CHECK_FRACTIONS = (0.1, 0.25, 0.5, 0.75)
 #: Raises at one check at most (each one level on the raised elements).
 RAISES_PER_CHECK = 3
 #: The estimate is this many times the change δ one level higher everywhere: δ / (1 − ρ) for
@@ -66,9 +68,11 @@ ANCHOR_REACH = 0.25
 LIFT_ITERATIONS = 20
 LIFT_BACKTRACKS = 8
 #: ... and of the state carried onto the bisected mesh (a start, not the same field): plain
-#: Newton first (demo 13 iterations, d10 20; fig. 5 and fig. 6 fail it, 2.3 s), then with the
-#: line search (fig. 5 17, fig. 6 20; it fails the demo and d10 after 4-5 s).
-LENGTH_ITERATIONS = (22, 24)
+#: Newton first, then with the line search. Its last iterations settle contact pairs in the
+#: penalty law's knee, converging linearly: plain Newton converges in 25 on fig. 6 and 36 on
+#: fig. 9 d20 (both at 6e-3 and 5e3 of residual after 22), fails fast on d30 (the residual grows
+#: 1e6-fold in 10).
+LENGTH_ITERATIONS = (40, 24)
 #: Newton's tolerance of an estimate's state (the path's where that is looser): its answer to
 #: ~1e-6, far below any tolerance a scene asks for.
 ESTIMATE_TOL = 1e-6
@@ -103,6 +107,10 @@ class OnePass:
         self._unreached: np.ndarray | None = None  # levels a check found no equilibrium at
         # the last state checked within the tolerance, or raised: where a raise goes back to
         self._anchor: PathState | None = None
+        self._first: PathState | None = None  # the path's first step: the first raise's anchor
+        # after the first raise: how far its check was (way to the target); the retaken state
+        # that gets there is the anchor of later raises
+        self._retaken_to: float | None = None
         self._raises: dict[bytes, np.ndarray | None] = {}  # levels → the raise above them
         self._kept_step = -1  # the step of the last check that kept the levels
         self._models: dict[bytes, BeamModel] = {}  # the higher models the checks use
@@ -121,6 +129,10 @@ class OnePass:
         goes on at the raised levels from the latest state where it had not. Any raise goes
         back to the last state a check kept or raised (:meth:`_back_to_anchor`).
         """
+        if self._first is None and state.step == 1:
+            self._first = state
+        if self._retaken_to is not None and self._way(state) >= self._retaken_to:
+            self._anchor, self._retaken_to = state, None
         recent = [s for s in self._recent if s.step < state.step and s.step > 0]
         self._recent = [*recent[-REWIND_STATES:], state]
         at_target = self._at_target(state)
@@ -144,11 +156,14 @@ class OnePass:
             checked, res = self._walk_back(start, earlier, found[0], checked, found[1])
             found = found[0], res
         if found is not None:
+            raised_at = checked
             checked, found = self._back_to_anchor(start, checked, found)
+            if checked is self._first and raised_at is not checked:
+                self._retaken_to = self._way(raised_at)
         self.checked_at_target = at_target and checked is state
         if found is None:
             self._kept_step = checked.step
-            self._anchor = checked
+            self._anchor, self._retaken_to = checked, None
             if self.checked_at_target and self.choice.estimate is not None:
                 self.lengths = self.length_estimate(state)
             return None
@@ -173,20 +188,26 @@ class OnePass:
 
         The states after it were followed at levels whose error grew past the tolerance
         before this check saw it; they are taken again at the raised levels, so that every
-        state of the path keeps the accuracy its check found — where that costs at most
+        state of the path keeps the accuracy its check found. The first raise has no such
+        state and goes back to the path's first step (no state before it was checked: on c3 they
+        were level 1's, and a debond's first growth load read from them was 3.0 % above the
+        raised levels'); later raises, where that costs at most
         ``ANCHOR_REACH`` of the steps so far (or ``REWIND_STATES``): a long path (fig. 7 c4, 34
         steps at the check, 16 at the anchor) keeps those states at the levels they were
         computed with, each within the raising check's estimate. ``found``: the raised levels and
         the checked state raised; kept where the anchor does not lift with the same inertia.
         """
-        anchor = self._anchor
-        if anchor is None or anchor.step >= checked.step or (
-                checked.step - anchor.step > max(REWIND_STATES, ANCHOR_REACH * checked.step)):
+        anchor, first = self._anchor, self._anchor is None
+        if first:  # the first raise: no state before it was checked
+            anchor = self._first
+        if anchor is None or anchor.step >= checked.step or (not first and (
+                checked.step - anchor.step > max(REWIND_STATES, ANCHOR_REACH * checked.step))):
             return checked, found
         levels = found[0]
         lifted = self.lift(start, anchor.u, anchor.load_factor, dict(anchor.probes), levels,
                            self.model)
-        self.choice.passes.append(self._entry(anchor, levels, lifted, "back to the last check"))
+        what = "back to the first step" if first else "back to the last check"
+        self.choice.passes.append(self._entry(anchor, levels, lifted, what))
         if lifted is None or _same_inertia(anchor, lifted[1]) is not True:
             return checked, found
         return anchor, (levels, lifted[1])
@@ -473,15 +494,19 @@ class OnePass:
             return abs(state.load_factor - target) <= AT_TARGET * max(abs(target), 1e-12)
         return False
 
-    def _passed_fraction(self, state: PathState) -> bool:
-        """Whether ``state`` is past the next check fraction of the way (that one then done)."""
+    def _way(self, state: PathState) -> float:
+        """How far ``state`` is on the way to the target (the until probe's value, or load)."""
         a = self.scene.analysis
         ways = []
         if a.until_probe is not None and a.until_probe in state.probes and a.until_value:
             ways.append(state.probes[a.until_probe] / float(a.until_value))
         if a.until_load_factor:
             ways.append(state.load_factor / float(a.until_load_factor))
-        way = max(ways, default=0.0)
+        return max(ways, default=0.0)
+
+    def _passed_fraction(self, state: PathState) -> bool:
+        """Whether ``state`` is past the next check fraction of the way (that one then done)."""
+        way = self._way(state)
         passed = False
         while self._fractions and way >= self._fractions[0]:
             self._fractions.pop(0)

@@ -20,6 +20,7 @@ import sandwich.beam.one_pass as one_pass
 from sandwich.beam import run
 from sandwich.beam.build import scene_model_options
 from sandwich.beam.core_choice import choose_core_levels
+from sandwich.beam.core_levels import transfer
 from sandwich.models import run_model, with_options
 from sandwich.scene import Analysis
 from sandwich.scene_file import load_scene
@@ -60,6 +61,41 @@ def test_one_pass_raises_along_the_path_and_ends_where_its_final_levels_end():
     for s in r.states[raised:]:
         residual = m.internal_force(s.u) - s.load_factor * m.f_ref
         assert np.linalg.norm(residual) <= 1e-6 * abs(s.load_factor) * np.linalg.norm(m.f_ref)
+
+
+def test_the_first_raise_takes_the_path_again_from_its_first_step(monkeypatch):
+    """No state of the path keeps levels no check has seen: the states before the first check
+    that raises are taken again at its levels. Reference: the models at the linear step's and at
+    the raised levels, built on their own; the early states (carried onto the final levels, which
+    adds zero amplitudes) are equilibria of the raised model, not of the linear step's."""
+    raised = []
+    original = one_pass.OnePass._back_to_anchor
+
+    def spy(self, start, checked, found):
+        if self._anchor is None:
+            raised.append((checked.step, found[0].copy()))
+        return original(self, start, checked, found)
+
+    monkeypatch.setattr(one_pass.OnePass, "_back_to_anchor", spy)
+    scene, elements = _fig5()
+    r = run(scene, elements=elements)
+    assert raised  # fig. 5's first check raises (measured: at step 6)
+    step, levels = raised[0]
+    first = choose_core_levels(scene, elements, scene_model_options(scene)).levels
+    assert not np.array_equal(levels, first)
+
+    def relative_residual(levels_, s):
+        m = run(scene, elements=elements, model_options={"core_level": levels_}).model
+        u = transfer(s.u, r.model, m)
+        residual = m.internal_force(u) - s.load_factor * m.f_ref
+        return np.linalg.norm(residual) / (abs(s.load_factor) * np.linalg.norm(m.f_ref))
+
+    assert step > 3
+    for s in r.states[1:4]:
+        assert relative_residual(levels, s) <= 1e-6
+        assert relative_residual(first, s) > 1e-3
+    stages = [p["stage"] for p in r.solution.extra["core"]["passes"]]
+    assert "check at step 1 (back to the first step)" in stages
 
 
 def test_a_critical_point_after_a_raise_is_located_on_the_raised_model():
