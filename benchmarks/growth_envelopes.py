@@ -208,6 +208,11 @@ def main() -> None:
                 ref = {k: float(ref[k]) for k in ("first_growth_N", "residual_strength_N")}
             rows += objectivity(case, wanted, ref)
         rows.sort(key=lambda r: (list(CASES).index(r["case"]), VARIANTS.index(r["variant"])))
+        for r in rows:  # against the defaults row as it is now (kept rows were against theirs)
+            ref = next((d for d in rows if d["case"] == r["case"]
+                        and d["variant"] == "defaults"), None)
+            for k in ("first_growth", "residual_strength") if ref is not None else ():
+                r[f"{k}_change"] = f"{float(r[f'{k}_N']) / float(ref[f'{k}_N']) - 1:+.4f}"
         write_rows(path, OBJ_FIELDS, rows)
         write_objectivity(rows)
         return

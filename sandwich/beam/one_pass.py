@@ -14,13 +14,15 @@ is hierarchical, so the state is exactly a state of the higher model
 Within the tolerance, the path goes on. Beyond it, the levels are raised where the error lives
 (:func:`~sandwich.beam.core_controller.raised_levels`: every debonded stretch and load patch and
 the residual's share, up to ``max_core_level``), the state is re-converged there and checked
-again, and the path goes on at the raised levels from the last state a check kept (the steps
-after it are taken again; the first raise takes it again from its first step), so every state
-keeps the accuracy its check found. A raised model
-with no equilibrium near the checked state, or with another inertia there, has left this path's
-branch: the raise goes back to an earlier state. The estimate at the target is the run's, with
-the element length's share added there: the state re-converged with every element split in two
-at the same levels (:meth:`OnePass.length_estimate`), which only advises more elements.
+again, and the path goes on at the raised levels from the last state a check kept, the steps
+after it taken again. The first raise, which has no such state, takes the path again from its
+first step (where that lifts with the same inertia), and the retaken state that gets as far as
+its check is then where later raises go back to: every state keeps the accuracy a check found.
+A raised model with no equilibrium near the checked state, or with another inertia there, has
+left this path's branch: the raise goes back to an earlier state. The estimate at the target is
+the run's, with the element length's share added there: the state re-converged with every
+element split in two at the same levels (:meth:`OnePass.length_estimate`), which only advises
+more elements.
 """
 
 from __future__ import annotations
@@ -105,7 +107,8 @@ class OnePass:
         self._fractions = list(CHECK_FRACTIONS)
         self._recent: list[PathState] = []  # the last states on the present model
         self._unreached: np.ndarray | None = None  # levels a check found no equilibrium at
-        # the last state checked within the tolerance, or raised: where a raise goes back to
+        # the last state checked within the tolerance, or raised (after the first raise: the
+        # retaken state at its check's position): where a raise goes back to
         self._anchor: PathState | None = None
         self._first: PathState | None = None  # the path's first step: the first raise's anchor
         # after the first raise: how far its check was (way to the target); the retaken state
@@ -127,11 +130,13 @@ class OnePass:
         inertia (its critical point lies before), up to ``REWIND_STATES`` earlier states are
         tried (:meth:`_walk_back`): the raised model has left this path's branch, and the path
         goes on at the raised levels from the latest state where it had not. Any raise goes
-        back to the last state a check kept or raised (:meth:`_back_to_anchor`).
+        back to the last state a check kept or raised, the first raise to the path's first step
+        (:meth:`_back_to_anchor`).
         """
         if self._first is None and state.step == 1:
             self._first = state
-        if self._retaken_to is not None and self._way(state) >= self._retaken_to:
+        way = self._way(state)
+        if self._retaken_to is not None and way is not None and way >= self._retaken_to:
             self._anchor, self._retaken_to = state, None
         recent = [s for s in self._recent if s.step < state.step and s.step > 0]
         self._recent = [*recent[-REWIND_STATES:], state]
@@ -158,8 +163,8 @@ class OnePass:
         if found is not None:
             raised_at = checked
             checked, found = self._back_to_anchor(start, checked, found)
-            if checked is self._first and raised_at is not checked:
-                self._retaken_to = self._way(raised_at)
+            retaken = checked is self._first and raised_at is not checked
+            self._retaken_to = self._way(raised_at) if retaken else None
         self.checked_at_target = at_target and checked is state
         if found is None:
             self._kept_step = checked.step
@@ -174,7 +179,8 @@ class OnePass:
         self._anchor = self._recent[0]
         if self.checked_at_target and self.choice.estimate is not None:
             self.lengths = self.length_estimate(self._recent[0])
-        self._kept_step = checked.step  # its raised state was checked in the raise loop
+        # its raised state was checked in the raise loop (the first step, taken back to, was not)
+        self._kept_step = -1 if found is not None and retaken else checked.step
         if self.progress is not None:
             self.progress(PathNote(f"core levels raised at step {checked.step}: elements per "
                                    f"core level {level_counts(levels)}", restart=False))
@@ -184,7 +190,7 @@ class OnePass:
 
     def _back_to_anchor(self, start: BeamModel, checked: PathState,
                         found: tuple[np.ndarray, object]) -> tuple[PathState, tuple | None]:
-        """Go back to the last state checked within the tolerance (or raised), if it lifts.
+        """Go back to the last state a check kept (the first raise: the first step), if it lifts.
 
         The states after it were followed at levels whose error grew past the tolerance
         before this check saw it; they are taken again at the raised levels, so that every
@@ -209,6 +215,7 @@ class OnePass:
         what = "back to the first step" if first else "back to the last check"
         self.choice.passes.append(self._entry(anchor, levels, lifted, what))
         if lifted is None or _same_inertia(anchor, lifted[1]) is not True:
+            self.choice.passes[-1]["kept"] = False  # the path goes on from the checked state
             return checked, found
         return anchor, (levels, lifted[1])
 
@@ -494,19 +501,22 @@ class OnePass:
             return abs(state.load_factor - target) <= AT_TARGET * max(abs(target), 1e-12)
         return False
 
-    def _way(self, state: PathState) -> float:
-        """How far ``state`` is on the way to the target (the until probe's value, or load)."""
+    def _way(self, state: PathState) -> float | None:
+        """How far ``state`` is on the way to the target (the until probe's value, or load).
+
+        None where the analysis has no target to measure it by.
+        """
         a = self.scene.analysis
         ways = []
         if a.until_probe is not None and a.until_probe in state.probes and a.until_value:
             ways.append(state.probes[a.until_probe] / float(a.until_value))
         if a.until_load_factor:
             ways.append(state.load_factor / float(a.until_load_factor))
-        return max(ways, default=0.0)
+        return max(ways) if ways else None
 
     def _passed_fraction(self, state: PathState) -> bool:
         """Whether ``state`` is past the next check fraction of the way (that one then done)."""
-        way = self._way(state)
+        way = self._way(state) or 0.0
         passed = False
         while self._fractions and way >= self._fractions[0]:
             self._fractions.pop(0)

@@ -18,7 +18,7 @@ from beam_scenes import sandwich_scene
 
 import sandwich.beam.one_pass as one_pass
 from sandwich.beam import run
-from sandwich.beam.build import scene_model_options
+from sandwich.beam.build import build_model, scene_gauss_orders, scene_model_options
 from sandwich.beam.core_choice import choose_core_levels
 from sandwich.beam.core_levels import transfer
 from sandwich.models import run_model, with_options
@@ -65,37 +65,49 @@ def test_one_pass_raises_along_the_path_and_ends_where_its_final_levels_end():
 
 def test_the_first_raise_takes_the_path_again_from_its_first_step(monkeypatch):
     """No state of the path keeps levels no check has seen: the states before the first check
-    that raises are taken again at its levels. Reference: the models at the linear step's and at
-    the raised levels, built on their own; the early states (carried onto the final levels, which
-    adds zero amplitudes) are equilibria of the raised model, not of the linear step's."""
-    raised = []
+    that raises are taken again at its levels, and a later raise goes back to the retaken state
+    that got as far as that check. Reference: the models at the linear step's and at the raised
+    levels, built on their own; the early states (carried onto the final levels, which adds zero
+    amplitudes) are equilibria of the raised model, not of the linear step's."""
+    raised, anchors = [], []
     original = one_pass.OnePass._back_to_anchor
 
     def spy(self, start, checked, found):
         if self._anchor is None:
-            raised.append((checked.step, found[0].copy()))
+            raised.append((checked.step, self._way(checked), found[0].copy()))
+        else:
+            anchors.append((self._anchor.step, self._way(self._anchor)))
         return original(self, start, checked, found)
 
     monkeypatch.setattr(one_pass.OnePass, "_back_to_anchor", spy)
     scene, elements = _fig5()
     r = run(scene, elements=elements)
     assert raised  # fig. 5's first check raises (measured: at step 6)
-    step, levels = raised[0]
-    first = choose_core_levels(scene, elements, scene_model_options(scene)).levels
+    step, way, levels = raised[0]
+    options = scene_model_options(scene)
+    first = choose_core_levels(scene, elements, options).levels
     assert not np.array_equal(levels, first)
 
-    def relative_residual(levels_, s):
-        m = run(scene, elements=elements, model_options={"core_level": levels_}).model
-        u = transfer(s.u, r.model, m)
-        residual = m.internal_force(u) - s.load_factor * m.f_ref
-        return np.linalg.norm(residual) / (abs(s.load_factor) * np.linalg.norm(m.f_ref))
+    def relative_residual(levels_, states):
+        m = build_model(scene, elements=elements, gauss=scene_gauss_orders(scene),
+                        **{**options, "core_level": levels_})
+        out = []
+        for s in states:
+            u = transfer(s.u, r.model, m)
+            residual = m.internal_force(u) - s.load_factor * m.f_ref
+            out.append(np.linalg.norm(residual)
+                       / (abs(s.load_factor) * np.linalg.norm(m.f_ref)))
+        return np.array(out)
 
     assert step > 3
-    for s in r.states[1:4]:
-        assert relative_residual(levels, s) <= 1e-6
-        assert relative_residual(first, s) > 1e-3
+    early = r.states[1:4]
+    assert np.all(relative_residual(levels, early) <= 1e-6)
+    assert np.all(relative_residual(first, early) > 1e-3)
     stages = [p["stage"] for p in r.solution.extra["core"]["passes"]]
     assert "check at step 1 (back to the first step)" in stages
+    # the later raise (measured: one, at step 8) goes back no earlier than the first check
+    assert anchors
+    assert all(a_step > 1 and a_way >= way for a_step, a_way in anchors)
 
 
 def test_a_critical_point_after_a_raise_is_located_on_the_raised_model():
