@@ -180,7 +180,7 @@ class OnePass:
         if self.checked_at_target and self.choice.estimate is not None:
             self.lengths = self.length_estimate(self._recent[0])
         # its raised state was checked in the raise loop (the first step, taken back to, was not)
-        self._kept_step = -1 if found is not None and retaken else checked.step
+        self._kept_step = -1 if retaken else checked.step
         if self.progress is not None:
             self.progress(PathNote(f"core levels raised at step {checked.step}: elements per "
                                    f"core level {level_counts(levels)}", restart=False))
@@ -197,7 +197,7 @@ class OnePass:
         state of the path keeps the accuracy its check found. The first raise has no such
         state and goes back to the path's first step (no state before it was checked: on c3 they
         were level 1's, and a debond's first growth load read from them was 3.0 % above the
-        raised levels'); later raises, where that costs at most
+        raised levels'). A later raise goes back only where that retakes at most
         ``ANCHOR_REACH`` of the steps so far (or ``REWIND_STATES``): a long path (fig. 7 c4, 34
         steps at the check, 16 at the anchor) keeps those states at the levels they were
         computed with, each within the raising check's estimate. ``found``: the raised levels and
