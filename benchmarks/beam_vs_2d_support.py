@@ -30,7 +30,7 @@ def main(argv: list[str] | None = None) -> int:
                              until_probe=None, until_value=None)
     s = dataclasses.replace(s, probes=probes, analysis=an)
     b = sandwich.beam.run(s, elements=a.elements).solution.history[-1].probes
-    r = sandwich.plane2d.solve(s, level=a.level).history[-1].probes
+    r = sandwich.plane2d.solve(s, level=a.level, estimate=False).history[-1].probes
     print(f"{'probe':14s} {'beam':>10s} {'2d':>10s} {'beam/2d':>8s}")
     for p in probes:
         print(f"{p.name:14s} {b[p.name]:10.5f} {r[p.name]:10.5f} {b[p.name] / r[p.name]:8.4f}")

@@ -114,7 +114,7 @@ def solve_reference(case: str) -> None:
 
     level = REFERENCE_LEVEL[case]
     t = time.perf_counter()
-    sol = solve2d(case_scene(case), level=level)
+    sol = solve2d(case_scene(case), level=level, estimate=False)
     path = OUT / "core_levels_2d.json"
     cached = json.loads(path.read_text()) if path.exists() else {}
     cached[case] = {"level": level, "lambda_end": sol.history[-1].load_factor,

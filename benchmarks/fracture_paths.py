@@ -44,7 +44,7 @@ def _solve(scene, model: str, level: str):
     from sandwich.plane2d.model import interface_z
     from sandwich.plane2d.solve import solve
 
-    sol = solve(scene, level=level, keep_states=True)
+    sol = solve(scene, level=level, keep_states=True, estimate=False)
     model, states = sol.reference2d_states
     radius = J_RADIUS_FACES * min(scene.top.thickness, scene.bottom.thickness)
     for t in VcctEvaluator(model).tips:

@@ -74,7 +74,7 @@ def load_case_reference(out: Path) -> tuple[float, str]:
         from sandwich.plane2d import solve as solve2d
 
         t = time.perf_counter()
-        sol = solve2d(load_case_scene(), level=LOAD_LEVEL)
+        sol = solve2d(load_case_scene(), level=LOAD_LEVEL, estimate=False)
         last = sol.history[-1]
         if abs(last.load_factor - LOAD_TARGET) > 1e-6 * LOAD_TARGET:
             raise SystemExit(f"2D {LOAD_LEVEL} stopped at λ {last.load_factor}: {sol.message}")

@@ -130,7 +130,7 @@ def main():
     scene = load_scene(ROOT / "scenes" / f"{SCENE}.toml")
     scene = dataclasses.replace(scene, analysis=dataclasses.replace(
         scene.analysis, until_value=args.until))
-    sol = solve(scene, level=args.level, keep_states=True)
+    sol = solve(scene, level=args.level, keep_states=True, estimate=False)
     model, states = sol.reference2d_states
     system = model.system
     assert sol.converged, sol.message

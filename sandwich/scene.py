@@ -251,6 +251,7 @@ class Reference2DOptions:
     contact_penalty: float | None = None
     profile_every: int = 0
     closure_length: float | None = None  # VCCT closure length (mm); None: the thinner face
+    error_estimate: bool = True  # the answer at the target against the next coarser level
 
 
 @dataclass(frozen=True)

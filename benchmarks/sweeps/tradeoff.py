@@ -282,7 +282,8 @@ def main(argv: list[str] | None = None) -> int:
         return MODELS["beam"].solve(scene)
 
     def ref_solve(scene: Scene, level: str, refine: int) -> Solution:
-        return MODELS["2d"].solve(with_options(scene, "2d", level=level, refine=refine))
+        return MODELS["2d"].solve(with_options(scene, "2d", level=level, refine=refine,
+                                              error_estimate=False))
 
     runs, lines = [], []
     warm_up(args.scenes[0], scene_levels.get(args.scenes[0], args.levels)[0],

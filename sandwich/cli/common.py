@@ -82,7 +82,13 @@ def overridden(scene: Scene, model: str, args: argparse.Namespace) -> Scene:
 
 
 def accuracy_line(model: str, sol: Solution) -> str:
-    """What a run says of its own accuracy: the beam's estimates per quantity, or none."""
+    """What a run says of its own accuracy: its estimates per quantity, or why there are none."""
+    mesh = sol.extra.get("mesh_error")
+    if isinstance(mesh, dict):
+        if mesh.get("not_measured"):
+            return f"{model}: the mesh's error is not estimated: {mesh['not_measured']}"
+        return (f"{model}: estimated error at the target (change from level "
+                f"{mesh.get('against')}): " + _per_quantity(mesh.get("quantities") or {}))
     core = sol.extra.get("core")
     if not isinstance(core, dict) or core.get("how") != "auto":
         return (f"{model}: no error estimate at a fixed resolution (compare with another "
@@ -95,6 +101,11 @@ def accuracy_line(model: str, sol: Solution) -> str:
     if not quantities:
         quantities = {"load and probes": {"estimated_error": est, "tolerance": tol}}
         what = "estimated error of the core levels"
+    return f"{model}: {what}: " + _per_quantity(quantities)
+
+
+def _per_quantity(quantities: dict) -> str:
+    """"name e % (within/above t %)" for every quantity with an estimate, comma-separated."""
     parts = []
     for name, q in quantities.items():
         e, t = q.get("estimated_error"), q.get("tolerance")
@@ -107,7 +118,7 @@ def accuracy_line(model: str, sol: Solution) -> str:
         if t is not None:
             said += f" ({'within' if e <= t else 'above'} {100 * t:.2g} %)"
         parts.append(said)
-    return f"{model}: {what}: " + ", ".join(parts)
+    return ", ".join(parts)
 
 
 def overridden_both(scene: Scene, args: argparse.Namespace) -> Scene:

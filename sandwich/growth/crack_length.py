@@ -117,7 +117,10 @@ def grow(scene: Scene, solve: Solve, progress: Callable[[ProgressItem], None] | 
     say = progress or (lambda item: None)
     t0 = time.perf_counter()
     rows: list[StepRecord] = []
-    stage, current = 0, scene
+    # each stage's path ends at the scene's target, not at its onset: a 2D mesh estimate there
+    # would measure the wrong state, at the cost of another path per stage
+    stage, current = 0, dataclasses.replace(
+        scene, reference2d=dataclasses.replace(scene.reference2d, error_estimate=False))
     last_solution: Solution | None = None
     last_cut: int | None = None
     stopped = ""

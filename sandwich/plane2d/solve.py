@@ -9,9 +9,10 @@ import numpy as np
 from sandwich.fracture import growth_onset
 from sandwich.plane2d.core_crushing import CoreCrushing, CoreState, crushing_warning
 from sandwich.plane2d.fracture import VcctEvaluator, history_columns
+from sandwich.plane2d.mesh_error import coarser_level, mesh_estimate, mesh_warnings, not_measured
 from sandwich.plane2d.model import Model2D, build_model
 from sandwich.plane2d.profiles import ProfileSampler
-from sandwich.results import Profile, Solution, StepRecord
+from sandwich.results import PathNote, Profile, Solution, StepRecord
 from sandwich.results.fracture import column_names
 from sandwich.scene import Scene
 from sandwich.solver.path import PathOptions, PathState, follow_path, solve_linear
@@ -29,7 +30,7 @@ def build_scene_mesh(scene: Scene, level: str | None = None, refine: int | None 
 
 def solve(scene: Scene, progress=None, level: str | None = None, refine: int | None = None,
           mesh=None, penalty: float | None = None, keep_states: bool = False,
-          closure_length: float | None = None) -> Solution:
+          closure_length: float | None = None, estimate: bool | None = None) -> Solution:
     """Solve ``scene`` with the 2D plane-stress reference.
 
     Parameters
@@ -51,7 +52,30 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     keep_states
         Keep the model and the displacement vector of every converged state on the returned
         solution (attribute ``reference2d_states``) for :func:`sandwich.plane2d.write_fields`.
+    estimate
+        Estimate the mesh's error at the target by solving the path again at the next coarser
+        level (:mod:`sandwich.plane2d.mesh_error`; summary ``mesh_error``); default
+        ``[reference2d] error_estimate``. Not with a ready ``mesh``.
     """
+    t0 = time.perf_counter()
+    level = scene.reference2d.level if level is None else level
+    refine = scene.reference2d.refine if refine is None else refine
+    given_mesh = mesh is not None
+    # the path's model is released before the coarser path runs (its memory is not held twice)
+    solution = _solve_path(scene, progress, level, refine, mesh, penalty, keep_states,
+                           closure_length)
+    if scene.reference2d.error_estimate if estimate is None else estimate:
+        entry = _mesh_error(scene, solution, level, refine, given_mesh, progress,
+                            dict(penalty=penalty, closure_length=closure_length))
+        solution.extra["mesh_error"] = entry
+        solution.warnings.extend(mesh_warnings(entry, level, refine))
+        solution.wall_seconds = time.perf_counter() - t0
+    return solution
+
+
+def _solve_path(scene: Scene, progress, level: str, refine: int, mesh, penalty: float | None,
+                keep_states: bool, closure_length: float | None) -> Solution:
+    """The path at one resolution: :func:`solve` without the mesh estimate."""
     t0 = time.perf_counter()
     if mesh is None:
         from mpi4py import MPI
@@ -182,6 +206,26 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     if keep_states:  # not part of the result contract: kept off ``extra`` (summary.json)
         solution.reference2d_states = (model, states)
     return solution
+
+
+def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given_mesh: bool,
+                progress, options: dict) -> dict[str, object]:
+    """``summary.json`` → ``mesh_error`` of ``solution``: the path again one level coarser."""
+    against = coarser_level(level, refine)
+    if given_mesh:
+        return not_measured("a mesh given to the solve has no coarser level")
+    if against is None:
+        return not_measured(f"level {level} at refine = {refine} has no coarser level to "
+                            "compare with (a medium or fine run has)")
+    if not solution.converged:
+        return not_measured(f"the path did not reach the target ({solution.message})",
+                            against)
+    if progress is not None:
+        progress(PathNote(f"estimating the mesh's error: the path again at level {against}",
+                          restart=False))
+    coarse = solve(scene, level=against.level, refine=against.refine, estimate=False,
+                   **options)
+    return mesh_estimate(solution, coarse, against)
 
 
 def _linear_target(scene: Scene, system, u1: np.ndarray) -> float:

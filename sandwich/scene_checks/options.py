@@ -154,7 +154,7 @@ def read_reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
     key = "reference2d"
     t = r.table(tbl, key, ("level", "refine", "face_elements", "core_size", "face_size",
                            "tip_size", "half_model", "contact_penalty", "profile_every",
-                           "closure_length"))
+                           "closure_length", "error_estimate"))
     if t is None:
         return Reference2DOptions()
     d = Reference2DOptions()
@@ -173,5 +173,6 @@ def read_reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
         contact_penalty=r.number(t, "contact_penalty", key, default=None, positive=True),
         profile_every=r.integer(t, "profile_every", key, default=0, lo=0) or 0,
         closure_length=r.number(t, "closure_length", key, default=None, positive=True),
+        error_estimate=r.boolean(t, "error_estimate", key, default=d.error_estimate),
         **sizes,
     )

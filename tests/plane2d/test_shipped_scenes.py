@@ -175,4 +175,8 @@ def test_solution_carries_a_paraview_frame_of_the_last_step(tmp_path):
     files = write_solution(sol, tmp_path / "out")
     names = {Path(f).name for f in files}
     assert "fields.pvd" in names and any(n.endswith(".vtu") for n in names)
-    assert all(isinstance(v, (int, float, str, bool)) or v is None for v in sol.extra.values())
+    assert all(isinstance(v, (int, float, str, bool)) or v is None
+               for k, v in sol.extra.items() if k != "mesh_error")
+    # level coarse has no coarser level: the estimate says so instead of a number
+    assert sol.extra["mesh_error"]["estimated_error"] is None
+    assert "no coarser level" in sol.extra["mesh_error"]["not_measured"]

@@ -1,0 +1,121 @@
+"""How accurate the 2D mesh is: the answer at the target against the next coarser level.
+
+The resolution levels are nested (``sandwich.meshes.levels``: "medium" splits every element of
+"coarse" along x and through the core in two, "fine" those of "medium", and each ``refine``
+halves every size). With an error e ∝ h^p, the change δ of a quantity from the next coarser
+level to this one is e (2^p − 1), so the error of this level is δ / (2^p − 1). The rates differ
+from quantity to quantity and scene to scene (benchmarks/results/reference2d/mesh_error.md):
+p ≈ 1 for the load of a peel couple (its crack tip's singularity governs it), about 1.4-1.7 for
+G and G_II/G at fig. 5's tip, about 3 for fig. 5's end load. The estimate takes the slowest,
+p = 1: δ itself (``ESTIMATE_FACTOR`` = 1). It is then the true error where the rate is 1 and
+errs on the safe side where the rate is higher (7 × the true error at p = 3, where that error
+is small).
+
+The coarser level follows the whole path again (about a quarter of the cells, a quarter to a
+third of the time): the two answers are compared at the target both reach. Level "coarse" and
+level "explicit" at ``refine = 0`` have no coarser level: no estimate (the summary says so).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from sandwich.results import Solution
+from sandwich.results.changes import answer_change, release_changes
+
+#: the next coarser level of each level that has one (at ``refine = 0``)
+COARSER = {"medium": "coarse", "fine": "medium"}
+RATE = 1.0  # the slowest convergence rate measured (a peel couple's load)
+ESTIMATE_FACTOR = 1.0 / (2.0**RATE - 1.0)
+#: what each quantity is held to (relative; G_II/G absolute): issue 47's targets for the 2D
+#: default level
+TOLERANCES = {"load and probes": 0.01, "G": 0.02, "G_II/G": 0.02}
+
+
+@dataclass(frozen=True)
+class Coarser:
+    """The level the estimate compares with."""
+
+    level: str
+    refine: int
+
+    def __str__(self) -> str:
+        refined = self.refine or self.level == "explicit"
+        return self.level + (f" + refine {self.refine}" if refined else "")
+
+
+def coarser_level(level: str, refine: int) -> Coarser | None:
+    """The next coarser resolution of ``level`` + ``refine`` halvings; None where none is."""
+    if refine > 0:
+        return Coarser(level, refine - 1)
+    if level in COARSER:
+        return Coarser(COARSER[level], 0)
+    return None
+
+
+def not_measured(reason: str, against: Coarser | None = None) -> dict[str, object]:
+    """The summary entry of an estimate that could not be made, and why."""
+    return {"how": "change from the next coarser mesh level",
+            "against": None if against is None else str(against),
+            "estimated_error": None, "quantities": {}, "tolerances": dict(TOLERANCES),
+            "not_measured": reason}
+
+
+def mesh_estimate(solution: Solution, coarse: Solution, against: Coarser) -> dict[str, object]:
+    """The summary entry ``mesh_error``: ``solution``'s answer at its target against ``coarse``.
+
+    Both must have reached the scene's target (their last states are then the same point of
+    the path); otherwise the estimate is not measured. Each quantity gets ``change`` (the
+    change from the coarser level), ``estimated_error`` (``ESTIMATE_FACTOR`` × it) and
+    ``tolerance``.
+    """
+    if not solution.history:
+        return not_measured("the path has no converged state", against)
+    if not coarse.converged or not coarse.history:
+        return not_measured(f"the path at level {against} did not reach the target "
+                            f"({coarse.message})", against)
+    mine, theirs = solution.history[-1], coarse.history[-1]
+    changes: dict[str, float] = {}
+    answer = answer_change(mine.load_factor, dict(mine.probes), theirs.load_factor,
+                           dict(theirs.probes))
+    if answer is not None:
+        changes["load and probes"] = answer
+    changes.update(release_changes(_releases(mine.extra), _releases(theirs.extra)))
+    if not changes:
+        return not_measured("nothing to compare at the target (no load, no probe moved)",
+                            against)
+    quantities = {name: {"change": float(change),
+                         "estimated_error": float(ESTIMATE_FACTOR * change),
+                         "tolerance": TOLERANCES[name]}
+                  for name, change in changes.items()}
+    return {"how": "change from the next coarser mesh level",
+            "against": str(against),
+            "estimated_error": quantities.get("load and probes", {}).get("estimated_error"),
+            "quantities": quantities, "tolerances": dict(TOLERANCES),
+            "rate": RATE, "estimate_factor": ESTIMATE_FACTOR,
+            "coarser_answer": {"load_factor": float(theirs.load_factor),
+                               "probes": {k: float(v) for k, v in theirs.probes.items()},
+                               "extra": _releases(theirs.extra)},
+            "coarser_cells": coarse.extra.get("cells"),
+            "coarser_seconds": float(coarse.wall_seconds)}
+
+
+def mesh_warnings(entry: dict[str, object], level: str, refine: int) -> list[str]:
+    """One warning per quantity whose estimate exceeds its tolerance, saying what would help."""
+    out = []
+    here = str(Coarser(level, refine))
+    finer = "level fine" if level in ("coarse", "medium") and refine == 0 else \
+        f"refine = {refine + 1}"
+    for name, q in (entry.get("quantities") or {}).items():
+        if q["estimated_error"] > q["tolerance"]:
+            out.append(f"2D mesh: the estimated error of {name} at the target, "
+                       f"{100 * q['estimated_error']:.2g} %, exceeds "
+                       f"{100 * q['tolerance']:.2g} % (level {here} against "
+                       f"{entry['against']}); a finer mesh ({finer}) would lower it")
+    return out
+
+
+def _releases(extra: dict[str, object]) -> dict[str, float | None]:
+    """The G columns of a history row's extra columns."""
+    return {k: (None if v is None else float(v)) for k, v in extra.items()
+            if k.startswith(("G_", "GI_", "GII_"))}
