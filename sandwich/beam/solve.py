@@ -34,6 +34,7 @@ from sandwich.beam.one_pass import G_TOLERANCE, OnePass
 from sandwich.beam.path_pass import PathPass, follow_penalised
 from sandwich.beam.solution import beam_solution, growth_summary
 from sandwich.results import InterruptedSolve, Solution
+from sandwich.results.changes import STRESS_QUANTITIES, STRESS_TOLERANCE
 from sandwich.scene import Scene
 from sandwich.solver import PathState
 
@@ -206,7 +207,13 @@ def _total(parts: dict[str, float | None]) -> float | None:
 
 
 def _tolerance(name: str, tolerance: float) -> float:
-    """What a quantity is held to: G and G_II/G ``G_TOLERANCE``, the rest the scene's."""
+    """What a quantity is held to.
+
+    G and G_II/G ``G_TOLERANCE``, the averaged stresses ``STRESS_TOLERANCE``, the load and
+    probes the scene's.
+    """
+    if name in STRESS_QUANTITIES:
+        return STRESS_TOLERANCE
     return G_TOLERANCE if name.startswith("G") else tolerance
 
 

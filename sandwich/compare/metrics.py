@@ -49,8 +49,8 @@ from sandwich.compare.profiles import (
 from sandwich.compare.releases import ReleaseAgreement, release_agreements
 from sandwich.models import ModelRun
 from sandwich.results import Solution
+from sandwich.results.peaks import PEAK_WINDOW
 
-PEAK_WINDOW = 5.0  # mm: averaging window of the windowed stress peaks (10 face thicknesses)
 CRITICAL_KINDS = ("bifurcation", "max")  # the critical points compared, in this order
 
 

@@ -21,7 +21,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from sandwich.results import Solution
-from sandwich.results.changes import answer_change, release_changes
+from sandwich.results.changes import (
+    STRESS_QUANTITIES,
+    STRESS_TOLERANCE,
+    answer_change,
+    averaged_peaks,
+    release_changes,
+    stress_changes,
+)
 
 #: the next coarser level of each level that has one (at ``refine = 0``)
 COARSER = {"medium": "coarse", "fine": "medium"}
@@ -29,7 +36,8 @@ RATE = 1.0  # the slowest convergence rate measured (a peel couple's load)
 ESTIMATE_FACTOR = 1.0 / (2.0**RATE - 1.0)
 #: what each quantity is held to (relative; G_II/G absolute): issue 47's targets for the 2D
 #: default level
-TOLERANCES = {"load and probes": 0.01, "G": 0.02, "G_II/G": 0.02}
+TOLERANCES = {"load and probes": 0.01, "G": 0.02, "G_II/G": 0.02,
+              **{name: STRESS_TOLERANCE for name in STRESS_QUANTITIES}}
 
 
 @dataclass(frozen=True)
@@ -65,9 +73,10 @@ def mesh_estimate(solution: Solution, coarse: Solution, against: Coarser) -> dic
     """The summary entry ``mesh_error``: ``solution``'s answer at its target against ``coarse``.
 
     Both must have reached the scene's target (their last states are then the same point of
-    the path); otherwise the estimate is not measured. Each quantity gets ``change`` (the
-    change from the coarser level), ``estimated_error`` (``ESTIMATE_FACTOR`` × it) and
-    ``tolerance``.
+    the path); otherwise the estimate is not measured. The quantities: the load and probes, G
+    and G_II/G at the debond tips, and the 5-mm averaged peaks of the interface σzz and the
+    core τ (:mod:`sandwich.results.changes`). Each gets ``change`` (the change from the coarser
+    level), ``estimated_error`` (``ESTIMATE_FACTOR`` × it) and ``tolerance``.
     """
     if not solution.history:
         return not_measured("the path has no converged state", against)
@@ -81,6 +90,10 @@ def mesh_estimate(solution: Solution, coarse: Solution, against: Coarser) -> dic
     if answer is not None:
         changes["load and probes"] = answer
     changes.update(release_changes(_releases(mine.extra), _releases(theirs.extra)))
+    if solution.profiles and coarse.profiles and solution.profiles[-1].step == mine.step \
+            and coarse.profiles[-1].step == theirs.step:  # the 5-mm averaged stress peaks
+        changes.update(stress_changes(solution.profiles[-1].columns,
+                                      coarse.profiles[-1].columns))
     if not changes:
         return not_measured("nothing to compare at the target (no load, no probe moved)",
                             against)
@@ -95,7 +108,9 @@ def mesh_estimate(solution: Solution, coarse: Solution, against: Coarser) -> dic
             "rate": RATE, "estimate_factor": ESTIMATE_FACTOR,
             "coarser_answer": {"load_factor": float(theirs.load_factor),
                                "probes": {k: float(v) for k, v in theirs.probes.items()},
-                               "extra": _releases(theirs.extra)},
+                               "extra": _releases(theirs.extra),
+                               "stress_peaks": (averaged_peaks(coarse.profiles[-1].columns)
+                                                if coarse.profiles else {})},
             "coarser_cells": coarse.extra.get("cells"),
             "coarser_seconds": float(coarse.wall_seconds)}
 

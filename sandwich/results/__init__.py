@@ -37,8 +37,10 @@ from sandwich.results.writing import (
     write_solution,
 )
 
-__all__ = ["FIELDS_COLLECTION", "PROFILE_COLUMNS", "RESULT_FILES", "FieldFrame", "InterruptedSolve", "LimitPoint",
-           "OutputError", "PathNote", "Profile", "ProgressItem", "ResultMissing", "RunIdentity", "Solution", "StepRecord",
-           "atomic_write_text", "check_output_folder", "history_csv", "load_result",
-           "profiles_csv", "read_field_frames", "scene_digest", "source_digest", "summary_dict",
-           "write_solution"]
+__all__ = [
+    "FIELDS_COLLECTION", "PROFILE_COLUMNS", "RESULT_FILES", "FieldFrame",
+    "InterruptedSolve", "LimitPoint", "OutputError", "PathNote", "Profile", "ProgressItem",
+    "ResultMissing", "RunIdentity", "Solution", "StepRecord", "atomic_write_text",
+    "check_output_folder", "history_csv", "load_result", "profiles_csv",
+    "read_field_frames", "scene_digest", "source_digest", "summary_dict", "write_solution"
+]

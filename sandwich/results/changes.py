@@ -1,4 +1,4 @@
-"""How much a state's answer changes between two resolutions: the load, probes and G.
+"""How much a state's answer changes between two resolutions: load, probes, G and stresses.
 
 Both models' error estimates compare a state with the same state re-converged (beam) or
 solved (2D) at another resolution through these measures, so that "1 %" means the same in
@@ -6,6 +6,10 @@ every summary.
 """
 
 from __future__ import annotations
+
+import numpy as np
+
+from sandwich.results.peaks import PEAK_WINDOW, window_average
 
 
 def answer_change(load_factor: float, probes: dict[str, float], new_load_factor: float,
@@ -50,3 +54,65 @@ def release_changes(before: dict[str, float | None],
     if mixes:
         out["G_II/G"] = max(mixes)
     return out
+
+
+#: The averaged stress quantities: the interface σzz at both core boundaries together (relative
+#: to the larger peak), and the core shear τ at mid-core
+STRESS_QUANTITIES = {"interface sigma_zz": ("sigma_zz_top", "sigma_zz_bottom"),
+                     "core tau": ("tau_core",)}
+#: what their estimates are held to (relative)
+STRESS_TOLERANCE = 0.05
+
+
+def stress_changes(before: dict[str, np.ndarray], after: dict[str, np.ndarray],
+                   window: float = PEAK_WINDOW) -> dict[str, float]:
+    """The change of the window-averaged stress peaks between two states' profile columns.
+
+    Per :data:`STRESS_QUANTITIES`: the largest change of a column's averaged peak magnitude
+    relative to the largest of its group (a column that barely carries stress is not divided
+    by its own near-zero peak). Empty for a group with no stress, or a profile shorter than the
+    window.
+    """
+    out = {}
+    for name, columns in STRESS_QUANTITIES.items():
+        pairs = []
+        for column in columns:
+            if column not in before or column not in after:
+                continue
+            try:
+                pairs.append((_averaged_peak(before, column, window),
+                              _averaged_peak(after, column, window)))
+            except ValueError:  # the profile spans less than the window
+                continue
+        scale = max((abs(b) for b, _ in pairs), default=0.0)
+        if scale > 0.0:
+            out[name] = max(abs(a - b) for b, a in pairs) / scale
+    return out
+
+
+def averaged_peaks(columns: dict[str, np.ndarray],
+                   window: float = PEAK_WINDOW) -> dict[str, float]:
+    """The window-averaged peak magnitude of each stress column (MPa).
+
+    Every column of :data:`STRESS_QUANTITIES` that ``columns`` has and that spans the window.
+    """
+    out = {}
+    for group in STRESS_QUANTITIES.values():
+        for column in group:
+            if column in columns:
+                try:
+                    out[column] = _averaged_peak(columns, column, window)
+                except ValueError:
+                    continue
+    return out
+
+
+def _averaged_peak(columns: dict[str, np.ndarray], column: str, window: float) -> float:
+    """The largest magnitude of ``column`` averaged over ``window`` mm.
+
+    A magnitude, not a signed value: a symmetric scene carries equal and opposite shear peaks
+    either side of its middle, and which of the two is larger is round-off.
+    """
+    _, values = window_average(np.asarray(columns["x"], dtype=float),
+                               np.asarray(columns[column], dtype=float), window)
+    return float(np.abs(values).max())

@@ -36,8 +36,11 @@ def _canonical(value: object) -> object:
 
 
 def scene_digest(scene: object) -> str:
-    """SHA-256 of the scene's mechanical content (geometry, materials, debonds, supports, loads,
-    probes, analysis); name, description, file and the models' option tables are left out."""
+    """SHA-256 of the scene's mechanical content.
+
+    Geometry, materials, debonds, supports, loads, probes, analysis; name, description, file and
+    the models' option tables are left out.
+    """
     data = {f.name: getattr(scene, f.name) for f in dataclasses.fields(scene)  # type: ignore[arg-type]
             if f.name not in _NOT_CONTENT}
     data = {k: dataclasses.asdict(v) if dataclasses.is_dataclass(v) else
@@ -61,8 +64,10 @@ def _digest_of(root: str, packages: tuple[str, ...]) -> str:
 
 
 def source_digest(root: Path, packages: Iterable[str]) -> str:
-    """SHA-256 of the ``*.py`` sources of ``packages`` (folders or files) under ``root`` (read once per
-    process)."""
+    """SHA-256 of the ``*.py`` sources of ``packages`` (folders or files) under ``root``.
+
+    Read once per process.
+    """
     return _digest_of(str(Path(root).resolve()), tuple(packages))
 
 

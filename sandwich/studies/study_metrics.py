@@ -14,7 +14,7 @@ deflections are the scene's ``until`` probe (the first probe if it has none), in
   (:mod:`sandwich.growth.envelope`; empty otherwise, and the residual strength empty where no
   debond grew);
 - ``peak_sigma_zz`` (either interface) and ``peak_tau_core`` at the last profile (the last
-  converged step), raw and averaged over 5 mm (:func:`sandwich.compare.profiles.peak`, the window
+  converged step), raw and averaged over 5 mm (:func:`sandwich.results.peaks.peak`, the window
   the
   comparisons use: the raw peak at a debond tip grows under mesh refinement, the average converges);
 - ``contact_length``: length of x (mm) where either face presses on the core (contact pressure
@@ -34,8 +34,8 @@ import math
 import numpy as np
 
 from sandwich.compare.paths import crushed_state
-from sandwich.compare.profiles import peak
 from sandwich.results import Solution
+from sandwich.results.peaks import peak
 from sandwich.scene import Scene
 
 PEAK_WINDOW = 5.0  # mm

@@ -33,8 +33,8 @@ import numpy as np
 import pytest
 
 from sandwich.compare import compare
-from sandwich.compare.profiles import window_average
 from sandwich.models import MODELS
+from sandwich.results.peaks import window_average
 from sandwich.scene_file import load_scene
 
 pytestmark = pytest.mark.dolfinx
