@@ -33,6 +33,7 @@ from pathlib import Path
 from benchmarks.core_levels import case_scene, reference
 from benchmarks.provenance import RESULTS, add_out_argument, measured_on, write_rows
 from sandwich.beam import run
+from sandwich.results.changes import STRESS_QUANTITIES, averaged_peaks
 from sandwich.scene_file import load_scene
 
 OUT = RESULTS / "beam"
@@ -193,7 +194,45 @@ def measure(case: str, out: Path, tolerance_note: list[str]) -> list[dict]:
                  estimated="" if est is None else f"{100 * est:.3f} %",
                  parts="" if parts is None else _parts(parts),
                  ratio="" if ratio is None else f"{ratio:.2f}", verdict=verdict)]
-    return rows + release_rows(case, last, core, common)
+    return rows + release_rows(case, last, core, common) + stress_rows(case, s, core, common)
+
+
+def stress_rows(case: str, solution, core: dict, common: dict) -> list[dict]:
+    """The 5-mm averaged stress peaks against the 2D model's converged ones.
+
+    References: ``reference2d/mesh_error_references.json`` (benchmarks.mesh_error_2d: the
+    Richardson value of the 2D levels, or fine); each group's true error is its worst column's,
+    relative to the group's largest reference peak.
+    """
+    path = RESULTS / "reference2d" / "mesh_error_references.json"
+    refs = json.loads(path.read_text()).get(case, {}).get("values", {}) if path.exists() else {}
+    if not refs or not solution.profiles or solution.profiles[-1].step != \
+            solution.history[-1].step:
+        return []
+    beam = averaged_peaks(solution.profiles[-1].columns)
+    rows = []
+    for name, columns in STRESS_QUANTITIES.items():
+        keys = [c for c in columns if f"peak {c}" in refs and c in beam]
+        parts = core["quantities"].get(name)
+        if not keys or parts is None:
+            continue
+        scale = max(abs(refs[f"peak {c}"]) for c in keys)
+        worst = max(keys, key=lambda c: abs(beam[c] - refs[f"peak {c}"]))
+        true = abs(beam[worst] - refs[f"peak {worst}"]) / scale
+        est, tol = parts["estimated_error"], parts["tolerance"]
+        ratio = est / true if est is not None and true > 0 else None
+        verdict = ("true error below a tenth of the tolerance" if true <= 0.1 * tol else
+                   "not estimated" if est is None else
+                   "covered (1-5×)" if 1.0 <= ratio <= 5.0 else
+                   "low" if ratio < 1.0 else "high (> 5×)")
+        rows.append(dict(common, quantity=f"{name} (5 mm, {worst})", beam=f"{beam[worst]:.6g}",
+                         reference=f"{refs[f'peak {worst}']:.6g}",
+                         reference_from="2D converged, mesh_error_references.json",
+                         true=f"{100 * true:.3f} %",
+                         estimated="" if est is None else f"{100 * est:.3f} %",
+                         parts=_parts(parts), ratio="" if ratio is None else f"{ratio:.2f}",
+                         verdict=verdict))
+    return rows
 
 
 def release_rows(case: str, last, core: dict, common: dict) -> list[dict]:
