@@ -42,13 +42,7 @@ from sandwich.beam.fracture import release_columns
 from sandwich.beam.model import BeamModel
 from sandwich.beam.path_pass import max_penetration
 from sandwich.results import PathNote
-from sandwich.results.changes import (
-    STRESS_QUANTITIES,
-    STRESS_TOLERANCE,
-    answer_change,
-    release_changes,
-    stress_changes,
-)
+from sandwich.results.changes import answer_change, release_changes, stress_changes
 from sandwich.solver import PathState
 from sandwich.solver.controls import LoadConstraint, ProbeConstraint
 from sandwich.solver.newton import NewtonSettings, newton_correct
@@ -308,19 +302,18 @@ class OnePass:
         return None if raised is None else (levels, raised)
 
     def _within(self, estimate: float) -> bool:
-        """Whether the last estimate meets its tolerances: the answer's, at the target all.
+        """Whether the last estimate meets its tolerances: the answer's, at the target G's too.
 
-        At the target G and G_II/G (``G_TOLERANCE``) and the 5-mm averaged stress peaks
-        (``STRESS_TOLERANCE``) are held too, there only: along the way, where a tip is still
-        closed or barely open, its G's relative change one level higher is large (fig. 6 at a
-        fifth of its load: 49 %) and says nothing of G where the scene asks for it.
+        At the target G and G_II/G are held to ``G_TOLERANCE``, there only: along the way, where
+        a tip is still closed or barely open, its G's relative change one level higher is large
+        (fig. 6 at a fifth of its load: 49 %) and says nothing of G where the scene asks for it.
+        The averaged stress peaks are reported, not raised for: on fig. 9 d0 a raise for them
+        took 2.2 × the time and left them above 5 % (9.2 → 7.8 %).
         """
         if estimate > self.tolerance:
             return False
-        held = {"G": G_TOLERANCE, "G_II/G": G_TOLERANCE,
-                **{name: STRESS_TOLERANCE for name in STRESS_QUANTITIES}}
         return not self._hold_releases or all(
-            self.quantities.get(name, 0.0) <= tol for name, tol in held.items())
+            self.quantities.get(name, 0.0) <= G_TOLERANCE for name in ("G", "G_II/G"))
 
     def estimate(self, state: PathState, levels: np.ndarray) -> tuple | None:
         """The estimated error of ``state`` at ``levels``, and what it found, or None.
