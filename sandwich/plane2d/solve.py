@@ -19,6 +19,7 @@ from sandwich.solver.path import PathOptions, PathState, follow_path, solve_line
 
 MODEL_NAME = "2d"
 PENETRATION_BOUND = 1e-3  # penetration allowed, a fraction of the thinner face (docs/contact.md)
+PROGRESS_EVERY = 10  # the mesh estimate's coarser path is told every this many steps
 
 
 def build_scene_mesh(scene: Scene, level: str | None = None, refine: int | None = None):
@@ -220,11 +221,18 @@ def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given
     if not solution.converged:
         return not_measured(f"the path did not reach the target ({solution.message})",
                             against)
+    told = None
     if progress is not None:
-        progress(PathNote(f"estimating the mesh's error: the path again at level {against}",
-                          restart=False))
-    coarse = solve(scene, level=against.level, refine=against.refine, estimate=False,
-                   **options)
+        steps = len(solution.history) - 1
+        progress(PathNote(f"estimating the mesh's error: the path again at level {against} "
+                          f"(this one took {steps} steps)", restart=False))
+
+        def told(state) -> None:  # the coarser path's states are not this run's: told, not kept
+            if state.step and state.step % PROGRESS_EVERY == 0:
+                progress(PathNote(f"mesh estimate: level {against} at step {state.step}, "
+                                  f"λ = {state.load_factor:.6g}", restart=False))
+    coarse = solve(scene, progress=told, level=against.level, refine=against.refine,
+                   estimate=False, **options)
     return mesh_estimate(solution, coarse, against)
 
 
