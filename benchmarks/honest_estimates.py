@@ -32,6 +32,7 @@ from pathlib import Path
 
 from benchmarks.core_levels import case_scene, reference
 from benchmarks.provenance import RESULTS, add_out_argument, measured_on, write_rows
+from benchmarks.verdicts import verdict
 from sandwich.beam import run
 from sandwich.results.changes import STRESS_QUANTITIES, averaged_peaks
 from sandwich.scene_file import load_scene
@@ -178,14 +179,7 @@ def measure(case: str, out: Path, tolerance_note: list[str]) -> list[dict]:
         quantity, value = "end load", last.load_factor
     true = abs(value / ref - 1)
     tolerance_note.append(f"{tol:g}")
-    ratio = None if est is None or true == 0 else est / true
-    if true <= 0.1 * tol:
-        verdict = "true error below a tenth of the tolerance"
-    elif est is None:
-        verdict = "not estimated"
-    else:
-        verdict = "covered (1-5×)" if 1.0 <= ratio <= 5.0 else (
-            "low" if ratio < 1.0 else "high (> 5×)")
+    ratio, said = verdict(true, est, tol)
     levels = " ".join(f"L{k}:{v}" for k, v in core["passes"][-1]["elements_per_level"].items())
     common = dict(case=case, control=scene.analysis.control, levels=levels,
                   seconds=f"{seconds:.2f}", load=f"{load:.2f}")
@@ -193,7 +187,7 @@ def measure(case: str, out: Path, tolerance_note: list[str]) -> list[dict]:
                  reference_from=where, true=f"{100 * true:.3f} %",
                  estimated="" if est is None else f"{100 * est:.3f} %",
                  parts="" if parts is None else _parts(parts),
-                 ratio="" if ratio is None else f"{ratio:.2f}", verdict=verdict)]
+                 ratio="" if ratio is None else f"{ratio:.2f}", verdict=said)]
     return rows + release_rows(case, last, core, common) + stress_rows(case, s, core, common)
 
 
@@ -220,18 +214,14 @@ def stress_rows(case: str, solution, core: dict, common: dict) -> list[dict]:
         worst = max(keys, key=lambda c: abs(beam[c] - refs[f"peak {c}"]))
         true = abs(beam[worst] - refs[f"peak {worst}"]) / scale
         est, tol = parts["estimated_error"], parts["tolerance"]
-        ratio = est / true if est is not None and true > 0 else None
-        verdict = ("true error below a tenth of the tolerance" if true <= 0.1 * tol else
-                   "not estimated" if est is None else
-                   "covered (1-5×)" if 1.0 <= ratio <= 5.0 else
-                   "low" if ratio < 1.0 else "high (> 5×)")
+        ratio, said = verdict(true, est, tol)
         rows.append(dict(common, quantity=f"{name} (5 mm, {worst})", beam=f"{beam[worst]:.6g}",
                          reference=f"{refs[f'peak {worst}']:.6g}",
                          reference_from="2D converged, mesh_error_references.json",
                          true=f"{100 * true:.3f} %",
                          estimated="" if est is None else f"{100 * est:.3f} %",
                          parts=_parts(parts), ratio="" if ratio is None else f"{ratio:.2f}",
-                         verdict=verdict))
+                         verdict=said))
     return rows
 
 
@@ -253,15 +243,12 @@ def release_rows(case: str, last, core: dict, common: dict) -> list[dict]:
         ref, where = found
         true = abs(beam[name] - ref) if name == "G_II/G" else abs(beam[name] / ref - 1)
         est, tol = parts["estimated_error"], parts["tolerance"]
-        ratio = est / true if true > 0 else None
-        verdict = ("true error below a tenth of the tolerance" if true <= 0.1 * tol else
-                   "covered (1-5×)" if ratio is not None and 1.0 <= ratio <= 5.0 else
-                   "low" if ratio is not None and ratio < 1.0 else "high (> 5×)")
+        ratio, said = verdict(true, est, tol)
         rows.append(dict(common, quantity=f"{name} at the tip" if name == "G" else name,
                          beam=f"{beam[name]:.6g}", reference=f"{ref:.6g}", reference_from=where,
                          true=f"{100 * true:.3f} %", estimated=f"{100 * est:.3f} %",
                          parts=_parts(parts), ratio="" if ratio is None else f"{ratio:.2f}",
-                         verdict=verdict))
+                         verdict=said))
     return rows
 
 

@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 
 from benchmarks.provenance import RESULTS, add_out_argument, measured_on, write_rows
+from benchmarks.verdicts import verdict
 from sandwich.plane2d import solve
 from sandwich.plane2d.mesh_error import TOLERANCES, estimate_factor
 from sandwich.results.changes import STRESS_QUANTITIES, averaged_peaks
@@ -169,13 +170,7 @@ def run_case(case: str, measured: str) -> list[dict]:
         worst = max(keys, key=true_error)
         true, tol = true_error(worst), TOLERANCES[name]
         estimated = entry["quantities"][name]["estimated_error"]
-        ratio = estimated / true if true > 0 else math.inf
-        if true <= 0.1 * tol:
-            verdict = "true error below a tenth of the tolerance"
-        elif 1.0 <= ratio <= 5.0:
-            verdict = "covered (1-5×)"
-        else:
-            verdict = "low (< 1×)" if ratio < 1.0 else "high (> 5×)"
+        ratio, said = verdict(true, estimated, tol)
         ref, p = refs[worst]
         rows.append({"case": case, "levels": " / ".join(f"{lv}+{r}" for lv, r in levels),
                      "quantity": f"{name} ({worst})",
@@ -184,7 +179,7 @@ def run_case(case: str, measured: str) -> list[dict]:
                      "reference": (f"Richardson {ref:.6g}" if p is not None
                                    else f"fine ({source}): not asymptotic"),
                      "true": f"{100 * true:.3f} %", "estimated": f"{100 * estimated:.3f} %",
-                     "ratio": f"{ratio:.2f}", "verdict": verdict,
+                     "ratio": "" if ratio is None else f"{ratio:.2f}", "verdict": said,
                      "seconds_medium": f"{seconds - entry['coarser_seconds']:.1f}",
                      "seconds_coarse": f"{entry['coarser_seconds']:.1f}",
                      "measured": measured})

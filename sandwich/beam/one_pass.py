@@ -105,7 +105,6 @@ class OnePass:
         self.choice, self.model, self.progress = choice, model, progress
         self.capped = False
         self.checked_at_target = False
-        self._hold_releases = False  # the check under way holds G to G_TOLERANCE too
         # the last estimate of each quantity: "load and probes", and "G", "G_II/G" at the tips
         self.quantities: dict[str, float] = {}
         # at the target: the element length's share of each (None: not measured)
@@ -158,8 +157,7 @@ class OnePass:
             return None  # checked at these levels already
         start = self.model
         self._unreached = None
-        self._hold_releases = at_target and checked is state
-        found = self.check(checked)
+        found = self.check(checked, at_target=at_target and checked is state)
         if found is None and self._unreached is not None and earlier:
             levels = self._unreached
             checked, res = self._walk_back(start, earlier, levels, checked, None)
@@ -252,7 +250,8 @@ class OnePass:
             self.model = up
         return checked, res
 
-    def check(self, state: PathState) -> tuple[np.ndarray, object] | None:
+    def check(self, state: PathState,
+              at_target: bool = False) -> tuple[np.ndarray, object] | None:
         """Estimate the error of ``state``'s answer; raise while it exceeds the tolerance.
 
         The estimate (:meth:`estimate`): the state re-converged one level higher everywhere,
@@ -261,8 +260,10 @@ class OnePass:
         has crossed a critical point this path has not: fig. 6's wrinkling maximum, which
         level 1 does not have), the levels are kept. Else the state is re-converged at
         :func:`raised_levels` (the zones and the residual's share, up to ``max_core_level``)
-        and checked again there. Returns the raised levels and state (None: none raised);
-        the choice's estimate is the last one made; :attr:`model` is the raised model.
+        and checked again there. ``at_target``: the state is the path's target, where G and
+        G_II/G are held to ``G_TOLERANCE`` too (:meth:`_within`). Returns the raised levels and
+        state (None: none raised); the choice's estimate is the last one made; :attr:`model` is
+        the raised model.
         """
         levels = self.choice.levels.copy()
         current = state
@@ -274,7 +275,7 @@ class OnePass:
                 break
             estimate, crossed, look, up_state = found
             self.choice.estimate = estimate
-            if self._within(estimate) and not crossed:
+            if self._within(estimate, at_target) and not crossed:
                 break
             higher = self._raise_of(levels, current)
             if higher is None:
@@ -301,7 +302,7 @@ class OnePass:
             self.model, levels, raised, current = up, higher, res, after
         return None if raised is None else (levels, raised)
 
-    def _within(self, estimate: float) -> bool:
+    def _within(self, estimate: float, at_target: bool) -> bool:
         """Whether the last estimate meets its tolerances: the answer's, at the target G's too.
 
         At the target G and G_II/G are held to ``G_TOLERANCE``, there only: along the way, where
@@ -312,7 +313,7 @@ class OnePass:
         """
         if estimate > self.tolerance:
             return False
-        return not self._hold_releases or all(
+        return not at_target or all(
             self.quantities.get(name, 0.0) <= G_TOLERANCE for name in ("G", "G_II/G"))
 
     def estimate(self, state: PathState, levels: np.ndarray) -> tuple | None:

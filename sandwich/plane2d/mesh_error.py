@@ -7,7 +7,7 @@ level to this one is e (2^p − 1), so the error of this level is δ / (2^p − 
 from quantity to quantity and scene to scene (benchmarks/results/reference2d/mesh_error.md):
 p ≈ 1 for the load of a peel couple (its crack tip's singularity governs it), about 1.4-1.7 for
 G and G_II/G at fig. 5's tip, about 3 for fig. 5's end load. The estimate takes the slowest,
-p = 1: δ itself (``ESTIMATE_FACTOR`` = 1). It is then the true error where the rate is 1 and
+p = 1: δ itself (:func:`estimate_factor` = 1). It is then the true error where the rate is 1 and
 errs on the safe side where the rate is higher (7 × the true error at p = 3, where that error
 is small). The 5-mm averaged peak of the interface σzz sits at a crack tip or a support, where
 σzz is singular (r^−½); its average converges at p = ½ (the peel couple: 0.52), so its
@@ -35,19 +35,18 @@ from sandwich.results.changes import (
 #: the next coarser level of each level that has one (at ``refine = 0``)
 COARSER = {"medium": "coarse", "fine": "medium"}
 RATE = 1.0  # the slowest convergence rate measured (a peel couple's load)
-ESTIMATE_FACTOR = 1.0 / (2.0**RATE - 1.0)
 #: the rate taken for a quantity where it is not ``RATE``: the averaged peak of a stress singular
 #: at a crack tip or support
 RATES = {"interface sigma_zz": 0.5}
+#: what each quantity is held to (relative; G_II/G absolute): issue 47's targets for the 2D
+#: default level
+TOLERANCES = {"load and probes": 0.01, "G": 0.02, "G_II/G": 0.02,
+              **{name: STRESS_TOLERANCE for name in STRESS_QUANTITIES}}
 
 
 def estimate_factor(name: str) -> float:
     """The estimate of ``name``'s error over its change from the coarser level: 1 / (2^p − 1)."""
     return 1.0 / (2.0 ** RATES.get(name, RATE) - 1.0)
-#: what each quantity is held to (relative; G_II/G absolute): issue 47's targets for the 2D
-#: default level
-TOLERANCES = {"load and probes": 0.01, "G": 0.02, "G_II/G": 0.02,
-              **{name: STRESS_TOLERANCE for name in STRESS_QUANTITIES}}
 
 
 @dataclass(frozen=True)
@@ -100,10 +99,9 @@ def mesh_estimate(solution: Solution, coarse: Solution, against: Coarser) -> dic
     if answer is not None:
         changes["load and probes"] = answer
     changes.update(release_changes(_releases(mine.extra), _releases(theirs.extra)))
-    if solution.profiles and coarse.profiles and solution.profiles[-1].step == mine.step \
-            and coarse.profiles[-1].step == theirs.step:  # the 5-mm averaged stress peaks
-        changes.update(stress_changes(solution.profiles[-1].columns,
-                                      coarse.profiles[-1].columns))
+    mine_profile, their_profile = _target_profile(solution), _target_profile(coarse)
+    if mine_profile is not None and their_profile is not None:  # the 5-mm averaged peaks
+        changes.update(stress_changes(mine_profile, their_profile))
     if not changes:
         return not_measured("nothing to compare at the target (no load, no probe moved)",
                             against)
@@ -119,8 +117,8 @@ def mesh_estimate(solution: Solution, coarse: Solution, against: Coarser) -> dic
             "coarser_answer": {"load_factor": float(theirs.load_factor),
                                "probes": {k: float(v) for k, v in theirs.probes.items()},
                                "extra": _releases(theirs.extra),
-                               "stress_peaks": (averaged_peaks(coarse.profiles[-1].columns)
-                                                if coarse.profiles else {})},
+                               "stress_peaks": ({} if their_profile is None
+                                                else averaged_peaks(their_profile))},
             "coarser_cells": coarse.extra.get("cells"),
             "coarser_seconds": float(coarse.wall_seconds)}
 
@@ -144,3 +142,10 @@ def _releases(extra: dict[str, object]) -> dict[str, float | None]:
     """The G columns of a history row's extra columns."""
     return {k: (None if v is None else float(v)) for k, v in extra.items()
             if k.startswith(("G_", "GI_", "GII_"))}
+
+
+def _target_profile(solution: Solution) -> dict | None:
+    """The profile columns of ``solution``'s last state, None where it has none."""
+    if solution.profiles and solution.profiles[-1].step == solution.history[-1].step:
+        return solution.profiles[-1].columns
+    return None

@@ -73,20 +73,13 @@ def stress_changes(before: dict[str, np.ndarray], after: dict[str, np.ndarray],
     by its own near-zero peak). Empty for a group with no stress, or a profile shorter than the
     window.
     """
+    peaks_before, peaks_after = averaged_peaks(before, window), averaged_peaks(after, window)
     out = {}
     for name, columns in STRESS_QUANTITIES.items():
-        pairs = []
-        for column in columns:
-            if column not in before or column not in after:
-                continue
-            try:
-                pairs.append((_averaged_peak(before, column, window),
-                              _averaged_peak(after, column, window)))
-            except ValueError:  # the profile spans less than the window
-                continue
-        scale = max((abs(b) for b, _ in pairs), default=0.0)
+        both = [c for c in columns if c in peaks_before and c in peaks_after]
+        scale = max((peaks_before[c] for c in both), default=0.0)
         if scale > 0.0:
-            out[name] = max(abs(a - b) for b, a in pairs) / scale
+            out[name] = max(abs(peaks_after[c] - peaks_before[c]) for c in both) / scale
     return out
 
 
@@ -102,7 +95,7 @@ def averaged_peaks(columns: dict[str, np.ndarray],
             if column in columns:
                 try:
                     out[column] = _averaged_peak(columns, column, window)
-                except ValueError:
+                except ValueError:  # the profile spans less than the window
                     continue
     return out
 

@@ -152,11 +152,11 @@ def test_an_interrupt_keeps_the_streamed_steps_once_each(tmp_path, monkeypatch):
     calls = []
     check = one_pass.OnePass.check
 
-    def interrupted(self, state):
+    def interrupted(self, state, **kwargs):
         calls.append(state.step)
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return check(self, state)
+        return check(self, state, **kwargs)
 
     monkeypatch.setattr(one_pass.OnePass, "check", interrupted)
     with pytest.raises(KeyboardInterrupt):
