@@ -99,7 +99,9 @@ from sandwich.solver.controls import Constraint, LoadConstraint
 from sandwich.solver.sparse import SingularTangentError
 from sandwich.solver.system import DiscreteSystem, Factorization, inner_product
 
-__all__ = ["RISING", "NewtonResult", "NewtonSettings", "newton_correct", "solve_equilibrium"]
+__all__ = ["RISING", "NewtonResult", "NewtonSettings", "NewtonStep", "newton_correct",
+           "newton_step",
+           "solve_equilibrium"]
 
 _TINY = 1e-300
 
@@ -378,6 +380,64 @@ def _roundoff(system: DiscreteSystem, u: np.ndarray) -> float:
     except RECOVERABLE_ERRORS:
         return 0.0
     return value if math.isfinite(value) and value > 0.0 else 0.0
+
+
+@dataclass(frozen=True)
+class NewtonStep:
+    """One full Newton correction (:func:`newton_step`): the iterate it gives and its residuals.
+
+    ``contraction`` = ‖R‖ after / ‖R‖ before: in Newton's quadratic phase it is small, and the
+    iterate's remaining distance to the equilibrium is about that fraction of the correction.
+    ``factorization`` is the tangent's at the start.
+    """
+
+    u: np.ndarray
+    load_factor: float
+    residual_before: float
+    residual_after: float
+    factorization: Factorization
+
+    @property
+    def contraction(self) -> float:
+        """‖R‖ after the correction over ‖R‖ before it (0 where both vanish)."""
+        if self.residual_before == 0.0:
+            return 0.0 if self.residual_after == 0.0 else math.inf
+        return self.residual_after / self.residual_before
+
+
+def newton_step(system: DiscreteSystem, u: np.ndarray, load_factor: float,
+                constraint: Constraint) -> NewtonStep | None:
+    """One Newton correction of R(u, λ) = f_int(u) − λ f_ref = 0 under ``constraint``.
+
+    The linearised answer at ``(u, λ)``: δu = K⁻¹(−R) + δλ K⁻¹f_ref with δλ from the constraint
+    (the step increment counted from ``(u, λ)`` itself), and the residual at the new iterate.
+    None where the tangent is singular, the constraint has no solution there or a residual is not
+    finite.
+    """
+    dot = inner_product(system)
+    f_ref = np.asarray(system.f_ref, dtype=float)
+    u = np.asarray(u, dtype=float)
+    lam = float(load_factor)
+    with np.errstate(all="ignore"):
+        try:
+            res = np.asarray(system.internal_force(u), dtype=float) - lam * f_ref
+            fac = system.factorize(system.tangent(u))
+            du_r, du_f = _solve_both(fac, -res, f_ref)
+        except RECOVERABLE_ERRORS:
+            return None
+        dlam = constraint.delta_lambda(du_r, du_f, u, lam, np.zeros_like(u), 0.0)
+        if dlam is None or not math.isfinite(dlam):
+            return None
+        u1 = u + du_r + dlam * du_f
+        lam1 = lam + dlam
+        try:
+            res1 = np.asarray(system.internal_force(u1), dtype=float) - lam1 * f_ref
+        except RECOVERABLE_ERRORS:
+            return None
+        before, after = math.sqrt(dot(res, res)), math.sqrt(dot(res1, res1))
+    if not (math.isfinite(before) and math.isfinite(after)):
+        return None
+    return NewtonStep(u1, lam1, before, after, fac)
 
 
 def solve_equilibrium(

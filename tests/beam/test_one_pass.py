@@ -266,3 +266,35 @@ def test_the_element_length_estimate_covers_the_change_to_twice_the_elements():
     assert change <= parts["element_length"] <= 5 * change, (change, parts)
     assert parts["estimated_error"] == pytest.approx(parts["core_levels"]
                                                      + parts["element_length"])
+
+
+def test_the_linearised_check_decides_like_the_re_converged_one():
+    """Along the way a check decides from one Newton correction of the state carried one level
+    higher (OnePass.linearised) where that is clear of the tolerance by ONE_STEP_MARGIN. For
+    that decision to be the re-converged check's, the linearised change of the load must lie
+    within that factor of the re-converged one. Reference: Newton on the same higher model to
+    its residual tolerance 1e-6 from the same state, at fig. 5's states (60 elements, the linear
+    step's levels). Where that finds no equilibrium, the correction is not accepted either."""
+    scene, elements = _fig5()
+    options = scene_model_options(scene)
+    choice = choose_core_levels(scene, elements, options)
+    r = run(scene, elements=elements, model_options={"core_level": choice.levels})
+    check = one_pass.OnePass(scene, elements, {**options, "core_level": choice.levels}, choice,
+                             r.model)
+    up = check._model_at(np.minimum(choice.levels + 1, 6))
+    ratios = []
+    for state in r.states[1:]:
+        linear = check.linearised(up, state)
+        full = check.lift(r.model, state.u, state.load_factor, dict(state.probes),
+                          up.element_levels, up, tol=one_pass.ESTIMATE_TOL)
+        if full is None:  # no equilibrium near it one level higher: the correction says so
+            assert linear is None
+            continue
+        if linear is None:  # not accepted (the correction left most of the residual)
+            continue
+        ratios.append((float(linear[1].load_factor) - state.load_factor)
+                      / (float(full[1].load_factor) - state.load_factor))
+    print(ratios)
+    assert len(ratios) >= 5
+    margin = one_pass.ONE_STEP_MARGIN
+    assert all(1 / margin < q < margin for q in ratios), ratios
