@@ -255,6 +255,23 @@ class Reference2DOptions:
 
 
 @dataclass(frozen=True)
+class Accuracy:
+    """What a run estimates at its target and what it holds each to (table ``[accuracy]``).
+
+    Relative tolerances (G_II/G's absolute); None: each model's default (docs/scenes.md,
+    "Accuracy"). ``estimate_G`` / ``estimate_stresses`` False: G and G_II/G at the debond tips /
+    the averaged stress peaks are not estimated (the load and probes, the path's answer, always
+    are).
+    """
+
+    load: float | None = None  # the load at the target and every probe
+    G: float | None = None  # G at the debond tips; G_II/G
+    stresses: float | None = None  # 5-mm averaged peaks of the interface σzz and the core τ
+    estimate_G: bool = True
+    estimate_stresses: bool = True
+
+
+@dataclass(frozen=True)
 class Scene:
     """One problem, the single source of truth for every model."""
 
@@ -272,6 +289,7 @@ class Scene:
     analysis: Analysis
     beam_model: BeamModelOptions = field(default_factory=BeamModelOptions)
     reference2d: Reference2DOptions = field(default_factory=Reference2DOptions)
+    accuracy: Accuracy = field(default_factory=Accuracy)
     source: Path | None = None
 
     @property

@@ -86,3 +86,30 @@ def test_debond_reaching_a_beam_end_is_open_there_and_bonded_at_its_tip():
     assert scene.is_bonded("bottom", 0.0)
     zero = dataclasses.replace(scene, debonds=(Debond("top", 0.0, 0.0),))
     assert zero.is_bonded("top", 0.0)  # a zero-length debond is bonded
+
+
+def test_the_accuracy_table_sets_the_tolerances_and_what_is_estimated(tmp_path):
+    """``[accuracy] load`` is the beam's load tolerance too; ``false`` turns a kind off."""
+    text = (ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml").read_text()
+    path = tmp_path / "s.toml"
+    path.write_text(text + "\n[accuracy]\nload = 0.02\nG = false\nstresses = 0.1\n")
+    sc = load_scene(path)
+    assert sc.beam_model.tolerance == 0.02
+    assert (sc.accuracy.load, sc.accuracy.G, sc.accuracy.stresses) == (0.02, None, 0.1)
+    assert not sc.accuracy.estimate_G and sc.accuracy.estimate_stresses
+    plain = load_scene(ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
+    assert plain.accuracy.estimate_G and plain.accuracy.load is None
+
+
+def test_the_digest_keeps_a_default_accuracy_out_and_a_given_one_in():
+    """A scene without ``[accuracy]`` keeps the digest it had before the table existed (the
+    scene's mechanical content only); a given one changes it (it decides the beam's levels)."""
+    from sandwich.results import scene_digest
+    from sandwich.scene import Accuracy
+
+    sc = load_scene(ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
+    fields = [f.name for f in dataclasses.fields(sc)]
+    assert fields[-2:] == ["accuracy", "source"]
+    before = dataclasses.make_dataclass("Before", [(f, object) for f in fields[:-2]])
+    assert scene_digest(sc) == scene_digest(before(**{f: getattr(sc, f) for f in fields[:-2]}))
+    assert scene_digest(dataclasses.replace(sc, accuracy=Accuracy(G=0.05))) != scene_digest(sc)

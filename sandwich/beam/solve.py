@@ -30,11 +30,10 @@ from sandwich.beam.core_levels import LevelChoice, level_counts
 from sandwich.beam.fracture import beam_tips, level_warning
 from sandwich.beam.linear_step import linear_solution, toward_target
 from sandwich.beam.model import BeamModel
-from sandwich.beam.one_pass import G_TOLERANCE, OnePass
+from sandwich.beam.one_pass import OnePass, beam_tolerances
 from sandwich.beam.path_pass import PathPass, follow_penalised
 from sandwich.beam.solution import beam_solution, growth_summary
 from sandwich.results import InterruptedSolve, Solution
-from sandwich.results.changes import STRESS_QUANTITIES, STRESS_TOLERANCE
 from sandwich.scene import Scene
 from sandwich.solver import PathState
 
@@ -134,7 +133,8 @@ def run(
                   if nonlinear and path_passes(choice) > 1 else "")
         warnings.append(f"the core's estimated error {said} (max_core_level "
                         f"{bm.max_core_level}{reruns})")
-    warnings += quantity_warnings(quantities, float(bm.tolerance))
+    held = beam_tolerances(scene)
+    warnings += quantity_warnings(quantities, held)
     if capped:
         message += (f"; the debond and load zones are at max_core_level {bm.max_core_level}: "
                     "what a further raise there would change is not measured")
@@ -153,7 +153,7 @@ def run(
         "passes": choice.passes, "zones_at_max_level": capped,
         "tolerance": getattr(bm, "tolerance", None) if choice.how == "auto" else None,
         "quantities": {name: {**parts, "estimated_error": _total(parts),
-                              "tolerance": _tolerance(name, float(bm.tolerance))}
+                              "tolerance": held[name]}
                        for name, parts in quantities.items()},
     }
     solution.wall_seconds = time.perf_counter() - t0
@@ -206,18 +206,7 @@ def _total(parts: dict[str, float | None]) -> float | None:
     return None if any(v is None for v in values) else float(sum(values))
 
 
-def _tolerance(name: str, tolerance: float) -> float:
-    """What a quantity is held to.
-
-    G and G_II/G ``G_TOLERANCE``, the averaged stresses ``STRESS_TOLERANCE``, the load and
-    probes the scene's.
-    """
-    if name in STRESS_QUANTITIES:
-        return STRESS_TOLERANCE
-    return G_TOLERANCE if name.startswith("G") else tolerance
-
-
-def quantity_warnings(quantities: dict[str, dict], tolerance: float) -> list[str]:
+def quantity_warnings(quantities: dict[str, dict], held: dict[str, float]) -> list[str]:
     """What a run must say of its quantities' estimates at the target.
 
     The element length's share where not measured, or where a quantity's estimate (core levels
@@ -230,7 +219,7 @@ def quantity_warnings(quantities: dict[str, dict], tolerance: float) -> list[str
                    "not re-converge with every element split in two)")
         return out
     for name, parts in quantities.items():
-        total, tol = _total(parts), _tolerance(name, tolerance)
+        total, tol = _total(parts), held[name]
         if total is None or total <= tol:
             continue
         if name == "load and probes" and parts["core_levels"] > tol:

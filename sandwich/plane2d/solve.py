@@ -9,7 +9,13 @@ import numpy as np
 from sandwich.fracture import growth_onset
 from sandwich.plane2d.core_crushing import CoreCrushing, CoreState, crushing_warning
 from sandwich.plane2d.fracture import VcctEvaluator, history_columns
-from sandwich.plane2d.mesh_error import coarser_level, mesh_estimate, mesh_warnings, not_measured
+from sandwich.plane2d.mesh_error import (
+    coarser_level,
+    mesh_estimate,
+    mesh_warnings,
+    not_measured,
+    plane2d_tolerances,
+)
 from sandwich.plane2d.model import Model2D, build_model
 from sandwich.plane2d.profiles import ProfileSampler
 from sandwich.results import PathNote, Profile, Solution, StepRecord
@@ -212,15 +218,15 @@ def _solve_path(scene: Scene, progress, level: str, refine: int, mesh, penalty: 
 def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given_mesh: bool,
                 progress, options: dict) -> dict[str, object]:
     """``summary.json`` → ``mesh_error`` of ``solution``: the path again one level coarser."""
-    against = coarser_level(level, refine)
+    against, held = coarser_level(level, refine), plane2d_tolerances(scene)
     if given_mesh:
-        return not_measured("a mesh given to the solve has no coarser level")
+        return not_measured("a mesh given to the solve has no coarser level", held=held)
     if against is None:
         return not_measured(f"level {level} at refine = {refine} has no coarser level to "
-                            "compare with (a medium or fine run has)")
+                            "compare with (a medium or fine run has)", held=held)
     if not solution.converged:
         return not_measured(f"the path did not reach the target ({solution.message})",
-                            against)
+                            against, held)
     told = None
     if progress is not None:
         steps = len(solution.history) - 1
@@ -233,7 +239,7 @@ def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given
                                   f"λ = {state.load_factor:.6g}", restart=False))
     coarse = solve(scene, progress=told, level=against.level, refine=against.refine,
                    estimate=False, **options)
-    return mesh_estimate(solution, coarse, against)
+    return mesh_estimate(solution, coarse, against, held)
 
 
 def _linear_target(scene: Scene, system, u1: np.ndarray) -> float:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from sandwich.results.peaks import PEAK_WINDOW, window_average
+from sandwich.scene import Accuracy
 
 
 def answer_change(load_factor: float, probes: dict[str, float], new_load_factor: float,
@@ -109,3 +110,23 @@ def _averaged_peak(columns: dict[str, np.ndarray], column: str, window: float) -
     _, values = window_average(np.asarray(columns["x"], dtype=float),
                                np.asarray(columns[column], dtype=float), window)
     return float(np.abs(values).max())
+
+
+#: the quantities each kind of a scene's ``[accuracy]`` table names
+KINDS = {"load": ("load and probes",), "G": ("G", "G_II/G"), "stresses": tuple(STRESS_QUANTITIES)}
+
+
+def tolerances(accuracy: Accuracy, defaults: dict[str, float]) -> dict[str, float]:
+    """What each quantity a run estimates is held to, by quantity name.
+
+    Per kind of :data:`KINDS`: the scene's ``[accuracy]`` tolerance where given, else the
+    model's ``defaults[kind]``; the kinds the scene does not want estimated are left out.
+    """
+    wanted = {"load": True, "G": accuracy.estimate_G, "stresses": accuracy.estimate_stresses}
+    out = {}
+    for kind, names in KINDS.items():
+        if not wanted[kind]:
+            continue
+        given = getattr(accuracy, kind)
+        out.update({name: float(defaults[kind] if given is None else given) for name in names})
+    return out

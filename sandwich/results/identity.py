@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
+from sandwich.scene import Accuracy
+
 IDENTITY_KEY = "identity"  # the summary.json key holding RunIdentity.to_dict()
 # Scene fields that say nothing about the mechanics, or belong to one model only (compared
 # through RunIdentity.options instead, so that a beam result survives a change of the 2D mesh).
@@ -38,11 +40,14 @@ def _canonical(value: object) -> object:
 def scene_digest(scene: object) -> str:
     """SHA-256 of the scene's mechanical content.
 
-    Geometry, materials, debonds, supports, loads, probes, analysis; name, description, file and
-    the models' option tables are left out.
+    Geometry, materials, debonds, supports, loads, probes, analysis, and ``[accuracy]`` where it
+    is not the default (it decides the beam's levels; a scene without it keeps its digest); name,
+    description, file and the models' option tables are left out.
     """
     data = {f.name: getattr(scene, f.name) for f in dataclasses.fields(scene)  # type: ignore[arg-type]
             if f.name not in _NOT_CONTENT}
+    if data.get("accuracy") == Accuracy():
+        data.pop("accuracy")
     data = {k: dataclasses.asdict(v) if dataclasses.is_dataclass(v) else
             [dataclasses.asdict(x) if dataclasses.is_dataclass(x) else x for x in v]
             if isinstance(v, tuple) else v for k, v in data.items()}

@@ -10,7 +10,12 @@ from sandwich.scene import (
     SceneError,
 )
 from sandwich.scene_checks.geometry import read_beam, read_layers, read_materials
-from sandwich.scene_checks.options import read_analysis, read_beam_model, read_reference2d
+from sandwich.scene_checks.options import (
+    read_accuracy,
+    read_analysis,
+    read_beam_model,
+    read_reference2d,
+)
 from sandwich.scene_checks.reader import Reader, check_name, typename
 from sandwich.scene_checks.stations import (
     check_mechanism,
@@ -23,7 +28,7 @@ from sandwich.scene_checks.stations import (
 __all__ = ["TOP_KEYS", "build_scene"]
 
 TOP_KEYS = ("name", "description", "beam", "layers", "materials", "debonds", "supports", "loads",
-            "analysis", "probes", "beam_model", "reference2d")
+            "analysis", "probes", "beam_model", "reference2d", "accuracy")
 
 
 def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) -> Scene:
@@ -52,6 +57,10 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
             r.fail(f"beam_model.core_zones.{i}", f"[{z.start:g}, {z.end:g}] is not inside the "
                    f"beam [0, {L:g}]")
     reference2d = read_reference2d(r, data.get("reference2d", {}))
+    beam_tolerance_given = isinstance(data.get("beam_model"), dict) and (
+        "tolerance" in data["beam_model"])
+    accuracy, beam_model = read_accuracy(r, data.get("accuracy", {}), beam_model,
+                                         beam_tolerance_given)
     if not r.problems:
         check_mechanism(r, supports, debonds, length)
     if r.problems:
@@ -60,4 +69,4 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
                  top=layers["top"], core=layers["core"], bottom=layers["bottom"],
                  debonds=tuple(debonds), supports=tuple(supports), loads=tuple(loads),
                  probes=tuple(probes), analysis=analysis, beam_model=beam_model,
-                 reference2d=reference2d, source=source)
+                 reference2d=reference2d, accuracy=accuracy, source=source)

@@ -1,7 +1,8 @@
-"""The checks of the analysis and of the models' options (``[beam_model]``, ``[reference2d]``)."""
+"""The checks of the analysis, the models' options and ``[accuracy]``."""
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 from typing import Any
 
@@ -15,6 +16,7 @@ from sandwich.scene import (
     GRADINGS,
     MAX_CORE_LEVEL,
     MESH_LEVELS,
+    Accuracy,
     Analysis,
     BeamModelOptions,
     CoreZone,
@@ -23,8 +25,11 @@ from sandwich.scene import (
 )
 from sandwich.scene_checks.reader import Reader
 
-__all__ = ["MIN_TOL", "read_analysis", "read_beam_model", "read_reference2d"]
+__all__ = ["MIN_TOL", "read_accuracy", "read_analysis", "read_beam_model",
+           "read_reference2d"]
 
+#: the range a relative tolerance of ``[accuracy]`` (and ``[beam_model] tolerance``) must lie in
+TOLERANCE_RANGE = (1e-6, 0.5)
 MIN_TOL = 1e-14  # the Newton tolerance cannot go below round-off
 
 
@@ -108,9 +113,9 @@ def read_beam_model(r: Reader, tbl: Any) -> BeamModelOptions:
                    f"got {core!r}")
             core = d.core
     tolerance = r.number(t, "tolerance", key, default=d.tolerance, positive=True)
-    if tolerance is not None and not 1e-6 <= tolerance <= 0.5:
-        r.fail("beam_model.tolerance", f"must be between 1e-6 and 0.5 (a relative error), "
-               f"got {tolerance:g}")
+    if tolerance is not None and not TOLERANCE_RANGE[0] <= tolerance <= TOLERANCE_RANGE[1]:
+        r.fail("beam_model.tolerance", f"must be between {TOLERANCE_RANGE[0]:g} and "
+               f"{TOLERANCE_RANGE[1]:g} (a relative error), got {tolerance:g}")
         tolerance = None
     zones = []
     for i, z in enumerate(r.array_of_tables(t.get("core_zones", []), "beam_model.core_zones")):
@@ -176,3 +181,45 @@ def read_reference2d(r: Reader, tbl: Any) -> Reference2DOptions:
         error_estimate=r.boolean(t, "error_estimate", key, default=d.error_estimate),
         **sizes,
     )
+
+
+
+def read_accuracy(r: Reader, tbl: Any, beam_model: BeamModelOptions,
+                  beam_tolerance_given: bool) -> tuple[Accuracy, BeamModelOptions]:
+    """``[accuracy]``: the quantities a run estimates and their tolerances.
+
+    ``load`` is the beam's ``[beam_model] tolerance`` as well (given twice: refused); ``G`` and
+    ``stresses`` may be ``false`` (not estimated). Returns the table and the beam model's
+    options with its tolerance.
+    """
+    key = "accuracy"
+    t = r.table(tbl, key, ("load", "G", "stresses"))
+    if t is None:
+        return Accuracy(), beam_model
+    lo, hi = TOLERANCE_RANGE
+    values: dict[str, float | None] = {}
+    estimated: dict[str, bool] = {}
+    for k in ("load", "G", "stresses"):
+        v = t.get(k)
+        if v is False and k != "load":
+            values[k], estimated[k] = None, False
+            continue
+        if isinstance(v, bool):
+            r.fail(f"{key}.{k}", "expected a relative tolerance (a number)"
+                   + (" or false (not estimated)" if k != "load" else
+                      ": the load and probes are the path's answer, always estimated"))
+            values[k], estimated[k] = None, True
+            continue
+        x = r.number(t, k, key, default=None, positive=True)
+        if x is not None and not lo <= x <= hi:
+            r.fail(f"{key}.{k}", f"must be between {lo:g} and {hi:g} (a relative error), "
+                   f"got {x:g}")
+            x = None
+        values[k], estimated[k] = x, True
+    if values["load"] is not None and beam_tolerance_given:
+        r.fail(f"{key}.load", "the beam's tolerance of the load and probes is given twice (also "
+               "[beam_model] tolerance): keep this one")
+    elif values["load"] is not None:
+        beam_model = dataclasses.replace(beam_model, tolerance=values["load"])
+    return Accuracy(load=values["load"], G=values["G"], stresses=values["stresses"],
+                    estimate_G=estimated["G"], estimate_stresses=estimated["stresses"]), beam_model

@@ -298,3 +298,41 @@ def test_the_linearised_check_decides_like_the_re_converged_one():
     assert len(ratios) >= 5
     margin = one_pass.ONE_STEP_MARGIN
     assert all(1 / margin < q < margin for q in ratios), ratios
+
+
+def _with_accuracy(scene, **given):
+    from sandwich.scene import Accuracy
+
+    return dataclasses.replace(scene, accuracy=Accuracy(**given))
+
+
+def test_the_scene_narrows_the_quantities_and_sets_their_tolerances():
+    """``[accuracy]``: what the run estimates at the target and what it holds each to (fig. 5,
+    60 elements). Defaults: the load and probes 1 %, G and G_II/G 3 %, the stress peaks 5 %."""
+    scene, elements = _fig5()
+    held = run(scene, elements=elements).solution.extra["core"]["quantities"]
+    assert {name: q["tolerance"] for name, q in held.items()} == {
+        "load and probes": 0.01, "G": 0.03, "G_II/G": 0.03, "interface sigma_zz": 0.05,
+        "core tau": 0.05}
+    narrowed = dataclasses.replace(scene, beam_model=dataclasses.replace(
+        scene.beam_model, tolerance=0.02))  # what the reader makes of [accuracy] load = 0.02
+    narrowed = _with_accuracy(narrowed, load=0.02, estimate_G=False, stresses=0.1)
+    core = run(narrowed, elements=elements).solution.extra["core"]
+    assert core["tolerance"] == 0.02
+    assert {name: q["tolerance"] for name, q in core["quantities"].items()} == {
+        "load and probes": 0.02, "interface sigma_zz": 0.1, "core tau": 0.1}
+
+
+def test_g_is_held_to_the_scenes_tolerance_or_not_at_all():
+    """Fig. 5 under load control to λ 450 at the defaults: held to 3 %, G raises the tips to
+    level 3 (the test above); with ``G = false`` the check at the target keeps the levels the
+    load and probes need, lower at the tips, and reports no G."""
+    scene = load_scene(FIG5)
+    scene = dataclasses.replace(scene, analysis=dataclasses.replace(
+        scene.analysis, control="load", until_probe=None, until_value=None,
+        until_load_factor=450.0))
+    r = run(_with_accuracy(scene, estimate_G=False))
+    core = r.solution.extra["core"]
+    assert "G" not in core["quantities"] and "load and probes" in core["quantities"]
+    for x in (scene.debonds[0].start, scene.debonds[0].end):
+        assert all(z["level"] < 3 for z in core["levels"] if z["start"] <= x <= z["end"])

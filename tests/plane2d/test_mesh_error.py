@@ -122,3 +122,27 @@ def _peel_toml_lines() -> list[str]:
         "[analysis]", 'kind = "nonlinear"', 'control = "displacement"',
         'until = { probe = "w0", value = 0.1 }',
     ]
+
+
+def test_the_scene_narrows_the_quantities_and_sets_their_tolerances(tmp_path):
+    """The same run with ``[accuracy] G = 0.1, stresses = false``: G's change of about 5 % (the
+    test above) is within the scene's 10 %, so nothing is said of it; the stress peaks are not
+    estimated; the load keeps the 2D default, 1 %."""
+    from sandwich.cli import main as cli_main
+
+    text = "\n".join([
+        *_peel_toml_lines(),
+        "[reference2d]", 'level = "explicit"', "core_size = 4.0", "face_size = 8.0",
+        "tip_size = 4.0", "refine = 1",
+        "[accuracy]", "G = 0.1", "stresses = false"])
+    path = tmp_path / "peel.toml"
+    path.write_text(text + "\n")
+    out = tmp_path / "r"
+    assert cli_main(["solve", str(path), "--model", "2d", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    entry = summary["mesh_error"]
+    assert set(entry["quantities"]) == {"load and probes", "G", "G_II/G"}
+    assert entry["tolerances"] == {"load and probes": 0.01, "G": 0.1, "G_II/G": 0.1}
+    g = entry["quantities"]["G"]
+    assert 0.02 < g["estimated_error"] < g["tolerance"] == 0.1
+    assert not any("2D mesh: the estimated error of G" in w for w in summary["warnings"])
