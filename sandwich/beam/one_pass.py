@@ -14,19 +14,19 @@ state decides where its change is clear of the tolerance (``ONE_STEP_MARGIN``); 
 estimate, the run's, is always re-converged, and only there are G, G_II/G and the averaged
 stress peaks estimated.
 
-Within the tolerance (the scene's for the load and probes; at the target also ``G_TOLERANCE``
-for G and G_II/G at the debond tips), the path goes on. Beyond it, the levels are raised where
-the error lives (:func:`~sandwich.beam.core_controller.raised_levels`: every debonded stretch
-and load patch and the residual's share, up to ``max_core_level``), the state is re-converged
-there and checked again, and the path goes on at the raised levels from the last state a check
-kept, the steps after it taken again. The first raise, which has no such state, takes the path
-again from its first step (where that lifts with the same inertia), and the retaken state that
-gets as far as its check is then where later raises go back to: every state keeps the accuracy
-a check found. A raised model with no equilibrium near the checked state, or with another
-inertia there, has left this path's branch: the raise goes back to an earlier state. The
-estimate at the target is the run's, with the element length's share added there: the state
-re-converged with every element split in two at the same levels
-(:meth:`OnePass.length_estimate`), which only advises more elements.
+Within the tolerance (the scene's for the load and probes; at the target also its ``[accuracy] G``,
+by default ``G_TOLERANCE``, for G and G_II/G at the debond tips), the path goes on. Beyond it, the
+levels are raised where the error lives (:func:`~sandwich.beam.core_controller.raised_levels`:
+every debonded stretch and load patch and the residual's share, up to ``max_core_level``), the
+state is re-converged there and checked again, and the path goes on at the raised levels from the
+last state a check kept, the steps after it taken again. The first raise, which has no such state,
+takes the path again from its first step (where that lifts with the same inertia), and the retaken
+state that gets as far as its check is then where later raises go back to: every state keeps the
+accuracy a check found. A raised model with no equilibrium near the checked state, or with another
+inertia there, has left this path's branch: the raise goes back to an earlier state. The estimate
+at the target is the run's, with the element length's share added there: the state re-converged
+with every element split in two at the same levels (:meth:`OnePass.length_estimate`), which only
+advises more elements.
 """
 
 from __future__ import annotations
