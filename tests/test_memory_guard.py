@@ -9,6 +9,7 @@ The constants of the estimate are checked against the measurements they were fit
 
 import dataclasses
 import glob
+import os
 import sys
 from pathlib import Path
 
@@ -227,3 +228,23 @@ def test_the_contact_term_counts_the_entries_of_each_model_held():
     assert memory.held_levels(auto) == (2, memory.beam_level(auto)[0])
     assert memory.contact_bytes(auto) == memory.CONTACT_PER_ENTRY * sum(
         memory.pattern_entries(auto, level) for level in memory.held_levels(auto))
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="no process beside on one core")
+def test_the_2d_estimate_counts_the_mesh_estimates_process_beside_it(monkeypatch):
+    """At level medium with the mesh estimate on, the coarser path runs in a second process
+    (sandwich.plane2d.beside): the guard adds a 2D solve at level coarse, and nothing where that
+    process does not run (level coarse, the estimate off, SANDWICH_ESTIMATE_BESIDE=0)."""
+    sc = load_scene(ROOT / "scenes" / "paper-fig5-top-debond-40-load-top.toml")
+    assert sc.reference2d.level == "medium" and sc.reference2d.error_estimate
+
+    def at(**opts):
+        return dataclasses.replace(sc, reference2d=dataclasses.replace(sc.reference2d, **opts))
+
+    alone = memory.estimate(at(error_estimate=False), "2d").peak_bytes
+    coarse = memory.estimate(at(level="coarse", error_estimate=False), "2d").peak_bytes
+    monkeypatch.setenv("SANDWICH_ESTIMATE_BESIDE", "1")
+    assert memory.estimate(sc, "2d").peak_bytes == pytest.approx(alone + coarse)
+    assert memory.estimate(at(level="coarse"), "2d").peak_bytes == pytest.approx(coarse)
+    monkeypatch.setenv("SANDWICH_ESTIMATE_BESIDE", "0")
+    assert memory.estimate(sc, "2d").peak_bytes == pytest.approx(alone)

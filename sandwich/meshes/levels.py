@@ -28,6 +28,29 @@ MAX_FACE_ASPECT = 20.0  # coarse far-field element length / face element thickne
 #: aspect 20 are far too stiff in that bending (c4: +16 % at aspect 20, +0.7 % at 5 against the
 #: fine level; docs/meshes.md)
 MAX_DEBOND_ASPECT = 5.0
+#: the next coarser level of each level that has one (at ``refine = 0``): the levels are nested
+COARSER = {"medium": "coarse", "fine": "medium"}
+
+
+@dataclass(frozen=True)
+class Coarser:
+    """The next coarser resolution of a mesh: a level and its refinement count."""
+
+    level: str
+    refine: int
+
+    def __str__(self) -> str:
+        refined = self.refine or self.level == "explicit"
+        return self.level + (f" + refine {self.refine}" if refined else "")
+
+
+def coarser_level(level: str, refine: int) -> Coarser | None:
+    """The next coarser resolution of ``level`` + ``refine`` halvings; None where none is."""
+    if refine > 0:
+        return Coarser(level, refine - 1)
+    if level in COARSER:
+        return Coarser(COARSER[level], 0)
+    return None
 
 
 @dataclass(frozen=True)

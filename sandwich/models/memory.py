@@ -41,13 +41,17 @@ RSS measured by ``benchmarks/memory_guard.py`` on ``scenes/default.toml``
 - **2D solve**: ``TWO_D_BASE + TWO_D_PER_DOF · n · log2(n)`` for ``n`` DOFs (the MUMPS LDLᵀ factor
   of a 2D mesh under nested dissection grows as n log n), plus the kept states as above. ``n`` is
   twice the nodes of the 9-node quadrilateral mesh, whose cell count is computed exactly from the
-  mesh layout (:func:`mesh_size`, no gmsh).
+  mesh layout (:func:`mesh_size`, no gmsh). Where the mesh estimate's coarser path runs in a
+  process beside the solve (:func:`beside_estimate`), that process's estimate is added (derived:
+  a 2D solve at the coarser level; not fitted).
 - **2D mesh** (``sandwich mesh``): ``MESH_BASE + MESH_PER_CELL · cells``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
 import re
 import warnings
 from dataclasses import dataclass
@@ -278,14 +282,39 @@ def mesh_estimate(scene: Scene, states: int | None = None) -> MemoryEstimate:
 def reference2d_estimate(scene: Scene, states: int | None = None) -> MemoryEstimate:
     """Peak memory of a 2D solve of ``scene`` at its ``[reference2d]`` level and refinement.
 
-    ``states``: converged states kept (default: every step of ``analysis.max_steps``).
+    ``states``: converged states kept (default: every step of ``analysis.max_steps``). Where
+    the mesh estimate's coarser path runs in a process beside the solve
+    (:func:`beside_estimate`), that process's peak is added: both are held at once.
     """
     cells, nodes = mesh_size(scene)
     dofs = 2 * nodes
     peak = TWO_D_BASE + TWO_D_PER_DOF * n_log_n(dofs) + states_bytes(scene, "2d", states)
-    return MemoryEstimate("2D solve", peak, dofs,
-                          f"{_resolution_2d(scene)}: {cells} cells, about {dofs} DOFs",
+    beside = beside_estimate(scene)
+    detail = f"{_resolution_2d(scene)}: {cells} cells, about {dofs} DOFs"
+    if beside is not None:
+        peak += beside.peak_bytes
+        detail += f", and the mesh estimate's {beside.detail} beside it"
+    return MemoryEstimate("2D solve", peak, dofs, detail,
                           (*_keys_2d(scene), "analysis.max_steps"))
+
+
+def beside_estimate(scene: Scene) -> MemoryEstimate | None:
+    """The process beside a 2D solve of ``scene``: its mesh estimate's coarser path, or None.
+
+    That path runs in a second process (:mod:`sandwich.plane2d.beside`) where the estimate is on,
+    the level has a coarser one and the machine more than one core (and
+    ``SANDWICH_ESTIMATE_BESIDE`` is not ``0``); its peak is a 2D solve's at the coarser level.
+    """
+    from sandwich.meshes.levels import coarser_level
+
+    opts = scene.reference2d
+    against = coarser_level(opts.level, opts.refine)
+    if (not opts.error_estimate or against is None or (os.cpu_count() or 1) < 2
+            or os.environ.get("SANDWICH_ESTIMATE_BESIDE", "1") == "0"):
+        return None
+    coarser = dataclasses.replace(scene, reference2d=dataclasses.replace(
+        opts, level=against.level, refine=against.refine, error_estimate=False))
+    return reference2d_estimate(coarser)
 
 
 ESTIMATES = {"beam": beam_estimate, "2d": reference2d_estimate, "mesh": mesh_estimate}

@@ -20,8 +20,7 @@ level "explicit" at ``refine = 0`` have no coarser level: no estimate (the summa
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from sandwich.meshes.levels import Coarser, coarser_level
 from sandwich.results import Solution
 from sandwich.results.changes import (
     STRESS_TOLERANCE,
@@ -33,8 +32,9 @@ from sandwich.results.changes import (
 )
 from sandwich.scene import Accuracy, Scene
 
-#: the next coarser level of each level that has one (at ``refine = 0``)
-COARSER = {"medium": "coarse", "fine": "medium"}
+__all__ = ["Coarser", "coarser_level", "estimate_factor", "mesh_estimate", "mesh_warnings",
+           "not_measured", "plane2d_tolerances"]
+
 RATE = 1.0  # the slowest convergence rate measured (a peel couple's load)
 #: the rate taken for a quantity where it is not ``RATE``: the averaged peak of a stress singular
 #: at a crack tip or support
@@ -54,27 +54,6 @@ def plane2d_tolerances(scene: Scene) -> dict[str, float]:
 def estimate_factor(name: str) -> float:
     """The estimate of ``name``'s error over its change from the coarser level: 1 / (2^p − 1)."""
     return 1.0 / (2.0 ** RATES.get(name, RATE) - 1.0)
-
-
-@dataclass(frozen=True)
-class Coarser:
-    """The level the estimate compares with."""
-
-    level: str
-    refine: int
-
-    def __str__(self) -> str:
-        refined = self.refine or self.level == "explicit"
-        return self.level + (f" + refine {self.refine}" if refined else "")
-
-
-def coarser_level(level: str, refine: int) -> Coarser | None:
-    """The next coarser resolution of ``level`` + ``refine`` halvings; None where none is."""
-    if refine > 0:
-        return Coarser(level, refine - 1)
-    if level in COARSER:
-        return Coarser(COARSER[level], 0)
-    return None
 
 
 def not_measured(reason: str, against: Coarser | None = None,

@@ -7,6 +7,7 @@ import time
 import numpy as np
 
 from sandwich.fracture import growth_onset
+from sandwich.plane2d.beside import Beside, can_run_beside
 from sandwich.plane2d.core_crushing import CoreCrushing, CoreState, crushing_warning
 from sandwich.plane2d.fracture import VcctEvaluator, history_columns
 from sandwich.plane2d.mesh_error import (
@@ -68,12 +69,27 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     level = scene.reference2d.level if level is None else level
     refine = scene.reference2d.refine if refine is None else refine
     given_mesh = mesh is not None
-    # the path's model is released before the coarser path runs (its memory is not held twice)
-    solution = _solve_path(scene, progress, level, refine, mesh, penalty, keep_states,
-                           closure_length)
-    if scene.reference2d.error_estimate if estimate is None else estimate:
-        entry = _mesh_error(scene, solution, level, refine, given_mesh, progress,
-                            dict(penalty=penalty, closure_length=closure_length))
+    wanted = scene.reference2d.error_estimate if estimate is None else estimate
+    options = dict(penalty=penalty, closure_length=closure_length)
+    against = coarser_level(level, refine)
+    beside = None
+    if wanted and not given_mesh and against is not None and can_run_beside():
+        beside = Beside(scene, against, options)  # the coarser path, while this one runs
+        if progress is not None:
+            progress(PathNote(f"estimating the mesh's error: the path at level {against} "
+                              "runs in a second process beside this one", restart=False))
+    try:
+        # without a process beside, the path's model is released before the coarser path runs
+        # (its memory is not held twice)
+        solution = _solve_path(scene, progress, level, refine, mesh, penalty, keep_states,
+                               closure_length)
+    except BaseException:
+        if beside is not None:
+            beside.stop()
+        raise
+    if wanted:
+        entry = _mesh_error(scene, solution, level, refine, given_mesh, progress, options,
+                            beside)
         solution.extra["mesh_error"] = entry
         solution.warnings.extend(mesh_warnings(entry, level, refine))
         solution.wall_seconds = time.perf_counter() - t0
@@ -216,8 +232,12 @@ def _solve_path(scene: Scene, progress, level: str, refine: int, mesh, penalty: 
 
 
 def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given_mesh: bool,
-                progress, options: dict) -> dict[str, object]:
-    """``summary.json`` → ``mesh_error`` of ``solution``: the path again one level coarser."""
+                progress, options: dict, beside: Beside | None = None) -> dict[str, object]:
+    """``summary.json`` → ``mesh_error`` of ``solution``: the path again one level coarser.
+
+    ``beside``: that path, followed in a second process while this one ran (stopped unheard
+    where the run's path did not reach its target); else it is followed now.
+    """
     against, held = coarser_level(level, refine), plane2d_tolerances(scene)
     if given_mesh:
         return not_measured("a mesh given to the solve has no coarser level", held=held)
@@ -225,8 +245,18 @@ def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given
         return not_measured(f"level {level} at refine = {refine} has no coarser level to "
                             "compare with (a medium or fine run has)", held=held)
     if not solution.converged:
+        if beside is not None:
+            beside.stop()
         return not_measured(f"the path did not reach the target ({solution.message})",
                             against, held)
+    if beside is not None:
+        if progress is not None:
+            progress(PathNote(f"mesh estimate: waiting for the path at level {against} "
+                              "beside this one", restart=False))
+        coarse = beside.result()
+        if isinstance(coarse, str):
+            return not_measured(coarse, against, held)
+        return {**mesh_estimate(solution, coarse, against, held), "coarser_path": "beside"}
     told = None
     if progress is not None:
         steps = len(solution.history) - 1
@@ -239,7 +269,7 @@ def _mesh_error(scene: Scene, solution: Solution, level: str, refine: int, given
                                   f"λ = {state.load_factor:.6g}", restart=False))
     coarse = solve(scene, progress=told, level=against.level, refine=against.refine,
                    estimate=False, **options)
-    return mesh_estimate(solution, coarse, against, held)
+    return {**mesh_estimate(solution, coarse, against, held), "coarser_path": "after"}
 
 
 def _linear_target(scene: Scene, system, u1: np.ndarray) -> float:

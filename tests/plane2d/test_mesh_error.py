@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 
 import pytest
 
@@ -146,3 +147,35 @@ def test_the_scene_narrows_the_quantities_and_sets_their_tolerances(tmp_path):
     g = entry["quantities"]["G"]
     assert 0.02 < g["estimated_error"] < g["tolerance"] == 0.1
     assert not any("2D mesh: the estimated error of G" in w for w in summary["warnings"])
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="no process beside on one core")
+def test_the_coarser_path_beside_gives_the_estimate_it_gives_after(monkeypatch):
+    """With a free core the coarser path runs in a second process while the run follows its
+    own; its answer is the one the same path followed afterwards in this process gives
+    (reference: ``SANDWICH_ESTIMATE_BESIDE=0``, the sequential path), to the last digit."""
+    from sandwich.plane2d.solve import solve
+
+    sc = _peel()
+    monkeypatch.setenv("SANDWICH_ESTIMATE_BESIDE", "0")
+    after = solve(sc, refine=1).extra["mesh_error"]
+    monkeypatch.setenv("SANDWICH_ESTIMATE_BESIDE", "1")
+    beside = solve(sc, refine=1).extra["mesh_error"]
+    assert (after["coarser_path"], beside["coarser_path"]) == ("after", "beside")
+    assert beside["coarser_answer"] == after["coarser_answer"]
+    assert beside["quantities"] == after["quantities"]
+
+
+def test_a_run_that_stops_short_stops_the_process_beside():
+    """The run's path ends before its target (two steps allowed): there is nothing to compare,
+    the estimate says why, and the process beside is ended, not left running."""
+    import multiprocessing
+
+    from sandwich.plane2d.solve import solve
+
+    sc = _peel()
+    sc = dataclasses.replace(sc, analysis=dataclasses.replace(sc.analysis, max_steps=2))
+    sol = solve(sc, refine=1)
+    assert not sol.converged
+    assert "did not reach the target" in sol.extra["mesh_error"]["not_measured"]
+    assert not [p for p in multiprocessing.active_children() if "mesh estimate" in p.name]
