@@ -122,8 +122,9 @@ def tip_zones(model: BeamModel, tips: list[BeamTip]) -> list[np.ndarray]:
 def uniform_tip_levels(model: BeamModel, tips: list[BeamTip], levels: np.ndarray) -> np.ndarray:
     """``levels`` with every tip zone (:func:`tip_zones`) raised to the highest level in it.
 
-    What the automatic level choice should apply after each choice or raise so that no level
-    transition falls next to a tip (docs/fracture.md; not called by sandwich.beam.solve yet).
+    Applied after the automatic level choice and each of its raises
+    (:mod:`sandwich.beam.core_choice`, :func:`~sandwich.beam.core_controller.raised_levels`), so
+    that no level transition falls next to a tip (docs/fracture.md).
     """
     out = np.array(levels, dtype=int, copy=True)
     for near in tip_zones(model, tips):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+from collections.abc import Callable
 from typing import Any
 
 from sandwich.meshes.levels import Coarser
@@ -38,18 +39,22 @@ def can_run_beside() -> bool:
 
 
 class Beside:
-    """The coarser path at ``against`` followed in a spawned process, started at once.
+    """The coarser path at ``against`` followed in a spawned process by ``solve``, started at once.
+
+    ``solve`` is the 2D model's :func:`sandwich.plane2d.solve.solve` (passed in, so that this
+    module does not import the one that uses it), called with ``estimate=False``.
 
     :meth:`result` waits for its :class:`Solution` (or the reason it has none); :meth:`stop`
     ends it unheard (the run's own path did not reach its target, or was interrupted).
     """
 
-    def __init__(self, scene: Scene, against: Coarser, options: dict[str, Any]) -> None:
+    def __init__(self, solve: Callable[..., Solution], scene: Scene, against: Coarser,
+                 options: dict[str, Any]) -> None:
         self.against = against
         context = multiprocessing.get_context("spawn")
         self._conn, child = context.Pipe(duplex=False)
         self._process = context.Process(
-            target=_follow, args=(child, scene, against.level, against.refine, options),
+            target=_follow, args=(child, solve, scene, against.level, against.refine, options),
             name=f"sandwich 2D mesh estimate ({against})", daemon=True)
         self._process.start()
         child.close()
@@ -75,11 +80,10 @@ class Beside:
         self._conn.close()
 
 
-def _follow(conn: Any, scene: Scene, level: str, refine: int, options: dict[str, Any]) -> None:
+def _follow(conn: Any, solve: Callable[..., Solution], scene: Scene, level: str, refine: int,
+            options: dict[str, Any]) -> None:
     """In the process beside: the path at ``level`` + ``refine``, sent back through ``conn``."""
     try:
-        from sandwich.plane2d.solve import solve
-
         solution = solve(scene, level=level, refine=refine, estimate=False, **options)
         conn.send(("ok", solution))
     except BaseException as exc:  # noqa: BLE001 - every failure is the estimate's, said there

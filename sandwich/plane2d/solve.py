@@ -74,7 +74,7 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
     against = coarser_level(level, refine)
     beside = None
     if wanted and not given_mesh and against is not None and can_run_beside():
-        beside = Beside(scene, against, options)  # the coarser path, while this one runs
+        beside = Beside(solve, scene, against, options)  # the coarser path, while this one runs
         if progress is not None:
             progress(PathNote(f"estimating the mesh's error: the path at level {against} "
                               "runs in a second process beside this one", restart=False))
