@@ -81,8 +81,9 @@ def two_d_scene(level: str, refine: int, steps: int) -> str:
     process of its own, added by the guard, not fitted).
     """
     text = (ROOT / "scenes" / "default.toml").read_text()
-    text = text.replace('level = "coarse"',
-                        f'level = "{level}"\nrefine = {refine}\nerror_estimate = false')
+    text = re.sub(r'^level = "\w+".*$',
+                  f'level = "{level}"\nrefine = {refine}\nerror_estimate = false', text,
+                  count=1, flags=re.MULTILINE)
     return text.replace("max_steps = 400", f"max_steps = {steps}")
 
 
