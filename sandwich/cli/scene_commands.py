@@ -138,8 +138,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
             feed = _StepBar(bar)
             sol = run_model(scene, args.model, out, progress=feed)
     except InterruptedSolve:
-        print("interrupted while checking the core levels: the pass that reached the target is "
-              f"written to {out}/ (its warnings say how far it was checked)", file=sys.stderr)
+        what = ("checking the core levels" if args.model == "beam"
+                else "estimating the mesh's error")
+        print(f"interrupted while {what}: the path that reached the target is written to "
+              f"{out}/ (its warnings say what was not finished)", file=sys.stderr)
         return EXIT_STOPPED
     except KeyboardInterrupt:
         steps = feed.steps if feed is not None else 0

@@ -19,7 +19,7 @@ from sandwich.plane2d.mesh_error import (
 )
 from sandwich.plane2d.model import Model2D, build_model
 from sandwich.plane2d.profiles import ProfileSampler
-from sandwich.results import PathNote, Profile, Solution, StepRecord
+from sandwich.results import InterruptedSolve, PathNote, Profile, Solution, StepRecord
 from sandwich.results.fracture import column_names
 from sandwich.scene import Scene
 from sandwich.solver.path import PathOptions, PathState, follow_path, solve_linear
@@ -88,8 +88,22 @@ def solve(scene: Scene, progress=None, level: str | None = None, refine: int | N
             beside.stop()
         raise
     if wanted:
-        entry = _mesh_error(scene, solution, level, refine, given_mesh, progress, options,
-                            beside)
+        try:
+            entry = _mesh_error(scene, solution, level, refine, given_mesh, progress, options,
+                                beside)
+        except KeyboardInterrupt as exc:
+            if beside is not None:
+                beside.stop()
+            if type(exc) is not KeyboardInterrupt:  # a study's time limit goes on up as it is
+                raise
+            # a user's Ctrl-C: the path reached its target, it is the answer, written as such
+            solution.extra["mesh_error"] = not_measured(
+                "interrupted while the path was followed again one level coarser", against,
+                plane2d_tolerances(scene))
+            solution.warnings.append("interrupted while estimating the mesh's error: the path "
+                                     "reached its target, its mesh error is not measured")
+            solution.wall_seconds = time.perf_counter() - t0
+            raise InterruptedSolve(solution) from exc
         solution.extra["mesh_error"] = entry
         solution.warnings.extend(mesh_warnings(entry, level, refine))
         solution.wall_seconds = time.perf_counter() - t0

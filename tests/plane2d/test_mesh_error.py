@@ -179,3 +179,30 @@ def test_a_run_that_stops_short_stops_the_process_beside():
     assert not sol.converged
     assert "did not reach the target" in sol.extra["mesh_error"]["not_measured"]
     assert not [p for p in multiprocessing.active_children() if "mesh estimate" in p.name]
+
+
+@pytest.mark.parametrize("beside", ["1", "0"])
+def test_an_interrupt_during_the_estimate_keeps_the_path_that_reached_its_target(monkeypatch,
+                                                                                beside):
+    """Ctrl-C while the coarser path is compared (beside the run or after it): the run's own
+    path reached its target, so it is the answer (InterruptedSolve carries it, as the beam's
+    auto does), its estimate not measured and said so; no process is left beside."""
+    import importlib
+    import multiprocessing
+
+    from sandwich.results import InterruptedSolve
+
+    plane2d_solve = importlib.import_module("sandwich.plane2d.solve")  # the module, not solve()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setenv("SANDWICH_ESTIMATE_BESIDE", beside)
+    monkeypatch.setattr(plane2d_solve, "mesh_estimate", interrupted)
+    with pytest.raises(InterruptedSolve) as caught:
+        plane2d_solve.solve(_peel(), refine=1)
+    sol = caught.value.solution
+    assert sol.converged and sol.history
+    assert "interrupted" in sol.extra["mesh_error"]["not_measured"]
+    assert any("its mesh error is not measured" in w for w in sol.warnings)
+    assert not [p for p in multiprocessing.active_children() if "mesh estimate" in p.name]
