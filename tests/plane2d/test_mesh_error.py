@@ -187,12 +187,13 @@ def test_an_interrupt_during_the_estimate_keeps_the_path_that_reached_its_target
     """Ctrl-C while the coarser path is compared (beside the run or after it): the run's own
     path reached its target, so it is the answer (InterruptedSolve carries it, as the beam's
     auto does), its estimate not measured and said so; no process is left beside."""
-    import importlib
     import multiprocessing
+    import sys
 
+    import sandwich.plane2d  # noqa: F401 - loads the module sandwich.plane2d.solve
     from sandwich.results import InterruptedSolve
 
-    plane2d_solve = importlib.import_module("sandwich.plane2d.solve")  # the module, not solve()
+    plane2d_solve = sys.modules["sandwich.plane2d.solve"]  # the module, not its solve()
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
