@@ -43,7 +43,7 @@ from sandwich.beam.core_levels import LevelChoice, level_counts, transfer
 from sandwich.beam.fields import profile_columns
 from sandwich.beam.fracture import release_columns
 from sandwich.beam.model import BeamModel
-from sandwich.beam.path_pass import max_penetration
+from sandwich.beam.reconverging import LIFT_BACKTRACKS, Reconverging, probes_of
 from sandwich.results import PathNote
 from sandwich.results.changes import (
     STRESS_TOLERANCE,
@@ -53,10 +53,7 @@ from sandwich.results.changes import (
     tolerances,
 )
 from sandwich.solver import PathState
-from sandwich.solver.controls import LoadConstraint, ProbeConstraint
-from sandwich.solver.newton import NewtonResult, NewtonSettings, newton_correct, newton_step
 from sandwich.solver.path import Refinement
-from sandwich.solver.system import inner_product
 
 #: Fractions of the way to the target (the until probe's value, else the load) at which the
 #: levels are checked besides critical points and the target itself; the first raise takes the
@@ -78,11 +75,6 @@ G_TOLERANCE = 0.03
 #: A raise goes back to the last state a check kept if that retakes at most this fraction of
 #: the steps so far (or REWIND_STATES).
 ANCHOR_REACH = 0.25
-#: Newton's iterations and backtracking halvings of a state re-converged at other levels: a
-#: state carried over converged in 2-10 on fig. 5, fig. 6 and the demo scene, 15 once on c1;
-#: one that takes more has left the levels' equilibrium, and failing early keeps that cheap.
-LIFT_ITERATIONS = 20
-LIFT_BACKTRACKS = 8
 #: ... and of the state carried onto the bisected mesh (a start, not the same field): plain
 #: Newton first, then with the line search. Its last iterations settle contact pairs in the
 #: penalty law's knee, converging linearly: plain Newton converges in 25 on fig. 6 and 36 on
@@ -98,15 +90,10 @@ ESTIMATE_TOL = 1e-6
 #: 1 / ONE_STEP_MARGIN or above ONE_STEP_MARGIN times the tolerance, and the state is re-converged
 #: only in between. Measured at every state of fig. 5 (60 elements), the demo scene, fig. 6,
 #: fig. 7 c1 and c3 and fig. 9 d20 at the linear step's levels: where the correction was
-#: accepted (ONE_STEP_CONTRACTION), its change of the load was 0.90-1.03 × the re-converged one
-#: (0.72-1.42 × at the states it was not), so a decision at 1.25 × is the re-converged one's.
+#: accepted (reconverging.ONE_STEP_CONTRACTION), its change of the load was 0.90-1.03 × the
+#: re-converged one (0.72-1.42 × at the states it was not), so a decision at 1.25 × is the
+#: re-converged one's.
 ONE_STEP_MARGIN = 1.25
-#: ... where the correction left at most this fraction of the residual it started from. The
-#: residual after it says little of the load (contact pairs in the penalty law's knee: left
-#: 1.5-90 × with the load within 5 % on d20), but a large one is what a state with no equilibrium
-#: near it one level higher shows too (c1 past its load maximum: 50 ×, with a change of +0.11 %
-#: where the re-converged state does not exist), so those are re-converged.
-ONE_STEP_CONTRACTION = 0.75
 #: A state is at its target within this relative distance (the follower's own test is tighter).
 AT_TARGET = 1e-4
 
@@ -121,7 +108,7 @@ def beam_tolerances(scene: object) -> dict[str, float]:
                                        "G": G_TOLERANCE, "stresses": STRESS_TOLERANCE})
 
 
-class OnePass:
+class OnePass(Reconverging):
     """The follower's ``refine`` hook of an ``auto`` path: checks, raises, the estimate.
 
     ``choice`` (the linear step's) is updated in place: its levels, estimate and passes are the
@@ -215,7 +202,7 @@ class OnePass:
         levels, res = found
         self.choice.levels = levels
         self._recent = [PathState(checked.step, res.u, float(res.load_factor), 0,
-                                  _probes(self.model, res.u), res.factorization.negative_pivots)]
+                                  probes_of(self.model, res.u), res.factorization.negative_pivots)]
         self._anchor = self._recent[0]
         if self.checked_at_target and self.choice.estimate is not None:
             self.lengths = self.length_estimate(self._recent[0])
@@ -280,7 +267,7 @@ class OnePass:
             up, raised = lifted
             checked, res = older, raised
             entry["change"] = answer_change(older.load_factor, older.probes,
-                                            float(raised.load_factor), _probes(up, raised.u))
+                                            float(raised.load_factor), probes_of(up, raised.u))
         if res is not None:
             self.model = up
         return checked, res
@@ -319,7 +306,7 @@ class OnePass:
             if np.array_equal(higher, look[0]):  # converged to the path's tolerance from there
                 up = look[1]
                 lifted = self.lift(up, up_state.u, float(up_state.load_factor),
-                                   _probes(up, up_state.u), higher, up)
+                                   probes_of(up, up_state.u), higher, up)
                 if lifted is None:
                     self._unreached = higher
                     break
@@ -333,7 +320,7 @@ class OnePass:
                     break
                 up, res = lifted
             after = PathState(current.step, res.u, float(res.load_factor), 0,
-                              _probes(up, res.u), res.factorization.negative_pivots)
+                              probes_of(up, res.u), res.factorization.negative_pivots)
             self.model, levels, raised, current = up, higher, res, after
         return None if raised is None else (levels, raised)
 
@@ -437,7 +424,7 @@ class OnePass:
             return None
         model, res = lifted
         entry["change"] = entry["estimate"] = answer_change(
-            state.load_factor, state.probes, float(res.load_factor), _probes(model, res.u))
+            state.load_factor, state.probes, float(res.load_factor), probes_of(model, res.u))
         return entry["estimate"]
 
     def _model_at(self, levels: np.ndarray) -> BeamModel:
@@ -472,70 +459,6 @@ class OnePass:
             self._raises[key] = raised_levels(self.scene, self.elements, self.options,
                                               self.model, state, levels, self.top)
         return self._raises[key]
-
-    def lift(self, model: BeamModel, u: np.ndarray, lam: float, probes: dict[str, float],
-             levels: np.ndarray, up: BeamModel | None = None,
-             tol: float | None = None) -> tuple[BeamModel, object] | None:
-        """The state ``(u, λ)`` of ``model`` re-converged on the model at ``levels``, or None.
-
-        Newton with a backtracking line search from the carried-over state (new enrichment
-        amplitudes zero): :meth:`reconverge`. ``up``: the model at ``levels`` if built already;
-        ``tol``: Newton's (default the scene's).
-        """
-        if up is None:
-            up = build_model(self.scene, elements=self.elements,
-                             gauss=scene_gauss_orders(self.scene),
-                             **{**self.options, "core_level": levels})
-        return self.reconverge(up, transfer(u, model, up), lam, probes, tol, LIFT_BACKTRACKS)
-
-    def reconverge(self, up: BeamModel, start: np.ndarray, lam: float, probes: dict[str, float],
-                   tol: float | None, backtracks: int,
-                   iterations: int = 0) -> tuple[BeamModel, object] | None:
-        """Newton on ``up`` from ``start`` to the state at the same until probe (else load).
-
-        At the same value of the until probe where the scene has one, else at the same load;
-        ``backtracks`` halvings of a correction that does not lower the residual, at most
-        ``iterations`` (default ``LIFT_ITERATIONS``). None where Newton fails or the state
-        penetrates deeper than the model's bound.
-        """
-        constraint = self._constraint(up, lam, probes)
-        settings = NewtonSettings(
-            tol=float(self.scene.analysis.tol) if tol is None else tol,
-            max_iterations=iterations or LIFT_ITERATIONS,
-            force_floor=float(np.linalg.norm(up.f_ref)) * abs(lam), backtracks=backtracks)
-        res = newton_correct(up, start, lam, constraint, settings)
-        if not res.converged or res.load_factor == 0.0 or res.factorization is None:
-            return None
-        if max_penetration(up, [res.u]) > up.penetration_bound():
-            return None
-        return up, res
-
-    def linearised(self, up: BeamModel, state: PathState) -> tuple[BeamModel, object] | None:
-        """``state`` carried onto ``up`` and corrected once by Newton: the linearised response.
-
-        One correction at the same until probe, else load (:func:`newton_step`); None where it
-        leaves more than ``ONE_STEP_CONTRACTION`` of the carried-over state's residual or a
-        pair penetrates deeper than the model's bound. Its factorisation is the tangent's at
-        the carried-over state.
-        """
-        probes = dict(state.probes)
-        step = newton_step(up, transfer(state.u, self.model, up), state.load_factor,
-                           self._constraint(up, state.load_factor, probes))
-        if step is None or step.contraction > ONE_STEP_CONTRACTION or step.load_factor == 0.0:
-            return None
-        if max_penetration(up, [step.u]) > up.penetration_bound():
-            return None
-        return up, NewtonResult(True, step.u, step.load_factor, 1, step.residual_after,
-                                "one correction", step.factorization)
-
-    def _constraint(self, up: BeamModel, lam: float,
-                    probes: dict[str, float]) -> LoadConstraint | ProbeConstraint:
-        """What a state re-converged on ``up`` holds: the until probe's value, else the load."""
-        name = self._held_probe(probes)
-        if name is None:
-            return LoadConstraint(lam)
-        return ProbeConstraint(np.asarray(up.probe_vector(name), dtype=float),
-                               float(probes[name]), inner_product(up))
 
     def length_estimate(self, state: PathState) -> dict[str, float] | None:
         """The element length's share of the error of ``state`` (on :attr:`model`), or None.
@@ -587,7 +510,7 @@ class OnePass:
         or said (stresses) there only. None where nothing can be compared.
         """
         change = answer_change(state.load_factor, state.probes, float(res.load_factor),
-                               _probes(other, res.u))
+                               probes_of(other, res.u))
         if change is None:
             return None
         out = {"load and probes": ESTIMATE_FACTOR * change}
@@ -603,11 +526,6 @@ class OnePass:
                                       profile_columns(other, res.u))
             out.update({k: ESTIMATE_FACTOR * v for k, v in stresses.items()})
         return change, out
-
-    def _held_probe(self, probes: dict[str, float]) -> str | None:
-        """The probe a lift holds: the until probe (None without one, or at 0: the load)."""
-        name = self.scene.analysis.until_probe
-        return name if name and probes.get(name, 0.0) != 0.0 else None
 
     def _at_target(self, state: PathState) -> bool:
         a = self.scene.analysis
@@ -652,7 +570,3 @@ def _same_inertia(state: PathState, res: object) -> bool | None:
     """Whether ``res``'s factorised tangent has ``state``'s negative pivots (None: unknown)."""
     a, b = state.negative_pivots, res.factorization.negative_pivots
     return None if a is None or b is None else a == b
-
-
-def _probes(model: BeamModel, u: np.ndarray) -> dict[str, float]:
-    return {n: float(np.asarray(model.probe_vector(n)) @ u) for n in model.probe_rows}
