@@ -104,17 +104,53 @@ class Toughness:
     eta: float = 2.0  # Benzeggagh–Kenane exponent
 
 
+GROWTH_METHODS = ("crack-length", "cohesive")
+
+
 @dataclass(frozen=True)
 class Growth:
-    """How a debond is grown by crack-length control (:mod:`sandwich.growth`).
+    """How a debond is grown: by crack-length control or by a cohesive law.
 
-    The debond's tips advance by ``step`` (mm) one at a time, each time at the load where its
-    G reaches the Benzeggagh–Kenane toughness, until the debond is ``max_length`` long (mm;
-    ``None``: until a tip comes within one step of a beam end or of another debond).
+    ``method = "crack-length"`` (:mod:`sandwich.growth`): the debond's tips advance by ``step``
+    (mm) one at a time, each time at the load where its G reaches the Benzeggagh–Kenane
+    toughness, until the debond is ``max_length`` long (mm; ``None``: until a tip comes within
+    one step of a beam end or of another debond).
+
+    ``method = "cohesive"`` (beam: :mod:`sandwich.beam.cohesive`): the interface ahead of each
+    tip, over ``zone`` mm (``None``: to the beam end or the next debond on the interface),
+    carries a bilinear mixed-mode cohesive law of strengths ``sigma_c`` and ``tau_c`` (MPa) and
+    the debond's toughness, with the penalty ``stiffness`` (N/mm³; ``None``: the default of
+    :func:`sandwich.beam.cohesive_law.default_stiffness`). The tips move along the one path.
     """
 
     step: float = 2.0
     max_length: float | None = None
+    method: str = "crack-length"
+    sigma_c: float | None = None
+    tau_c: float | None = None
+    zone: float | None = None
+    stiffness: float | None = None
+
+    @property
+    def cohesive(self) -> bool:
+        """Whether the debond grows by the cohesive law."""
+        return self.method == "cohesive"
+
+
+@dataclass(frozen=True)
+class CohesiveSpan:
+    """The stretch of interface a cohesive tip may open: from ``origin`` (the tip) to ``far``."""
+
+    debond: int
+    tip: str  # "start" | "end"
+    interface: str
+    origin: float  # mm
+    far: float  # mm; below origin for a start tip
+
+    @property
+    def direction(self) -> int:
+        """+1 where the tip grows towards larger x (an end tip), −1 otherwise."""
+        return 1 if self.tip == "end" else -1
 
 
 @dataclass(frozen=True)
@@ -305,6 +341,32 @@ class Scene:
         """The debonds of one interface, sorted by start."""
         return tuple(sorted((d for d in self.debonds if d.interface == interface),
                             key=lambda d: d.start))
+
+    def cohesive_spans(self) -> list[CohesiveSpan]:
+        """Every tip of a debond grown by a cohesive law, with the stretch ahead it may open.
+
+        The stretch runs from the tip ``zone`` mm away from the debond (its ``growth.zone``),
+        at most to the beam end or to the next debond on the interface (to half way where that
+        one grows by a cohesive law too). An end at a beam end is an open mouth, not a tip.
+        """
+        tol = 1e-9 * self.length
+        out = []
+        for i, d in enumerate(self.debonds):
+            if d.growth is None or not d.growth.cohesive or d.length <= tol:
+                continue
+            # a neighbour growing towards this debond shares the stretch between them
+            others = [(o.start, o.end) if o.growth is None or not o.growth.cohesive
+                      else (0.5 * (d.end + o.start), 0.5 * (o.end + d.start))
+                      for o in self.debonds_on(d.interface) if o is not d]
+            reach = d.growth.zone if d.growth.zone is not None else self.length
+            if d.end < self.length - tol:
+                far = min([d.end + reach, self.length]
+                          + [a for a, _ in others if a > d.end])
+                out.append(CohesiveSpan(i, "end", d.interface, d.end, far))
+            if d.start > tol:
+                far = max([d.start - reach, 0.0] + [b for _, b in others if b < d.start])
+                out.append(CohesiveSpan(i, "start", d.interface, d.start, far))
+        return out
 
     def is_bonded(self, interface: str, x: float, tol: float = 1e-9) -> bool:
         """Whether ``x`` is bonded on ``interface``.

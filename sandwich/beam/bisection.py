@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sandwich.beam.cohesive import carry_damage
 from sandwich.beam.dofs import NODE_DOFS
 from sandwich.beam.mesh import BeamMesh
 from sandwich.beam.model import BeamModel
@@ -37,7 +38,8 @@ def bisected_state(u: np.ndarray, src: BeamModel, dst: BeamModel) -> np.ndarray:
     """Free DOFs of ``dst`` (``src`` bisected) carrying the state ``u`` of ``src``.
 
     Node by node (the 20 nodal DOFs, then each node's extra block): old nodes as they are,
-    midpoints the mean of their element's two nodes.
+    midpoints the mean of their element's two nodes. A cohesive interface's damage goes with
+    the state (:func:`~sandwich.beam.cohesive.carry_damage`: a midpoint the larger of its two).
     """
     n = src.mesh.n_nodes
     if dst.mesh.n_nodes != 2 * n - 1 or not np.array_equal(dst.mesh.x[0::2], src.mesh.x):
@@ -53,6 +55,7 @@ def bisected_state(u: np.ndarray, src: BeamModel, dst: BeamModel) -> np.ndarray:
     free = np.zeros(dst.size)
     live = dst.dof_map.free >= 0
     free[dst.dof_map.free[live]] = dst.dof_map.sign[live] * out[live]
+    carry_damage(src, dst)
     return free
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sandwich.beam.cohesive import cohesive_groups
 from sandwich.beam.constitutive import core_stiffness, face_stiffness
 from sandwich.beam.constraints import DofMap, NodeSupport, build_dof_map
 from sandwich.beam.contact_search import DEFAULT_REACH, contact_pair_groups
@@ -78,9 +79,10 @@ def refinement_zones(scene: object) -> list[tuple[float, float]]:
     A debonded face is free to buckle or wrinkle over its whole length; with the paper's face
     interpolation (u linear, w cubic) the buckled face locks in membrane unless its elements are
     short all along the debond, not only at the tips (measured on fig. 5: docs/beam_element.md,
-    speed).
+    speed). The stretches a cohesive tip may open too: its process zone runs along them.
     """
-    return [(d.start, d.end) for d in scene.debonds if d.end > d.start]
+    return ([(d.start, d.end) for d in scene.debonds if d.end > d.start]
+            + [tuple(sorted((s.origin, s.far))) for s in scene.cohesive_spans()])
 
 
 def default_contact_smoothing(scene: object) -> float:
@@ -195,10 +197,12 @@ def build_model(
                                            stiffness["core"], basis, level,
                                            gauss=orders["core"]),
         face_stretch)
-    dof_map, bonded = _dof_map(scene, mesh, mode_active, face_stretch)
+    cohesive = cohesive_groups(scene, mesh.x, stiffness["core"][1, 1])
+    dof_map, bonded = _dof_map(scene, mesh, mode_active, face_stretch, cohesive)
     pairs = [group for i in FACES if np.any(~bonded[i])
              for group in contact_pair_groups(i, np.flatnonzero(~bonded[i]), mesh.x, scene.width,
                                               search=contact_search, reach=contact_reach)]
+    pairs += cohesive
     if contact_penalty is None:
         contact_penalty = getattr(options, "contact_penalty", None)
     if contact_penalty is None:
@@ -274,22 +278,29 @@ def _core_layout(
 
 
 def _dof_map(
-    scene: object, mesh: BeamMesh, mode_active: np.ndarray, face_stretch: bool
+    scene: object, mesh: BeamMesh, mode_active: np.ndarray, face_stretch: bool,
+    cohesive: list,
 ) -> tuple[DofMap, dict[str, np.ndarray]]:
-    """The elimination of ties and supports, and each face's bonded nodes.
+    """The elimination of ties and supports, and each face's bonded nodes (contact elsewhere).
 
     With ``face_stretch`` a clamp also holds the face's stretch (``mode_active`` is changed in
-    place): it holds the face's whole end section, so no thickness change there.
+    place): it holds the face's whole end section, so no thickness change there. The nodes of
+    ``cohesive`` groups are untied (the law holds them), not bonded and not contact nodes.
     """
     tol = 1e-9 * scene.length
     bonded = {i: np.array([scene.is_bonded(i, float(x), tol) for x in mesh.x]) for i in FACES}
+    for group in cohesive:
+        bonded[group.interface][group.nodes] = True  # no contact pair of its own
+    ties = {i: b.copy() for i, b in bonded.items()}
+    for group in cohesive:
+        ties[group.interface][group.nodes] = False
     supports = [NodeSupport(mesh.node_at(s.x, 1e-6 * scene.length), face, s.type)
                 for s in scene.supports for face in s.faces]
     if face_stretch:
         for s in supports:
             if s.type == "clamp":
                 mode_active[s.node, FACES.index(s.face)] = False
-    return build_dof_map(mesh.n_nodes, bonded, supports, mode_active), bonded
+    return build_dof_map(mesh.n_nodes, ties, supports, mode_active), bonded
 
 
 def _reference_load(

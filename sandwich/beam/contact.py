@@ -8,12 +8,16 @@ Each contact pair's force f = −p A ∂g/∂u and consistent tangent K = −A p
 * the gap g and its derivatives (:mod:`sandwich.beam.contact_gap`, same-x;
   :mod:`sandwich.beam.contact_projection`, closest point);
 * the law p(g) (:mod:`sandwich.beam.contact_law`): a penalty regularised by a shifted softplus.
+
+A growing tip's cohesive pairs (:mod:`sandwich.beam.cohesive`) are same-x pairs whose response
+adds the cohesive law to the contact's.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from sandwich.beam.cohesive import cohesive_response
 from sandwich.beam.contact_gap import PairKinematics, same_x_kinematics
 from sandwich.beam.contact_law import penalty_blocks
 from sandwich.beam.contact_projection import chosen_segment_kinematics, pair_block_kinematics
@@ -51,6 +55,8 @@ def penalty_response(
     (:func:`block_rows`). ``smoothing`` is the regularisation width s (mm) of
     :func:`~sandwich.beam.contact_law.pressure_law`.
     """
+    if pairs.cohesive is not None:  # a growing tip's cohesive pairs
+        return cohesive_response(pairs, u_full, penalty, smoothing)
     k = pair_kinematics(pairs, u_full)
     f, K, p = penalty_blocks(k.gap, k.grad, k.hess, pairs.area, penalty, smoothing)
     return f, K, p, k

@@ -71,6 +71,45 @@ def gap_derivatives(
     return s_n * q / ℓ, dg, d2g
 
 
+def sliding_derivatives(
+    r1: np.ndarray, r2: np.ndarray, a: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sliding s = (a r1 + c r2)/√(a² + c²) with gradient and Hessian in (r1, r2, a, c).
+
+    The jump's component along the slave's deformed tangent (the cohesive law's mode II
+    jump, :mod:`sandwich.beam.cohesive`).
+    """
+    ℓ = np.sqrt(a**2 + c**2)
+    q = a * r1 + c * r2
+    z = np.zeros_like(ℓ)
+    dq = np.stack([a, c, r1, r2], axis=-1)
+    dℓ = np.stack([z, z, a / ℓ, c / ℓ], axis=-1)
+    d2q = np.zeros((*ℓ.shape, 4, 4))
+    d2q[..., 0, 2] = d2q[..., 2, 0] = 1.0
+    d2q[..., 1, 3] = d2q[..., 3, 1] = 1.0
+    d2ℓ = np.zeros((*ℓ.shape, 4, 4))
+    d2ℓ[..., 2, 2], d2ℓ[..., 3, 3] = c**2 / ℓ**3, a**2 / ℓ**3
+    d2ℓ[..., 2, 3] = d2ℓ[..., 3, 2] = -a * c / ℓ**3
+    ℓ1, q1 = ℓ[..., None], q[..., None]
+    ds = dq / ℓ1 - q1 * dℓ / ℓ1**2
+    cross = dq[..., :, None] * dℓ[..., None, :]
+    d2s = (d2q / ℓ1[..., None]
+           - (cross + np.swapaxes(cross, -1, -2)) / (ℓ1**2)[..., None]
+           - (q1 / ℓ1**2)[..., None] * d2ℓ
+           + (2 * q1 / ℓ1**3)[..., None] * dℓ[..., :, None] * dℓ[..., None, :])
+    return q / ℓ, ds, d2s
+
+
+def same_x_sliding(
+    pairs: ContactPairs, u_full: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sliding of same-x pairs with its gradient and Hessian on their six DOFs (PAIR_ROLES)."""
+    v = u_full[pairs.dofs]
+    s, ds, d2s = sliding_derivatives(v[:, 0] - v[:, 2], v[:, 1] - v[:, 3], 1.0 + v[:, 4],
+                                     v[:, 5])
+    return s, ds @ _D, _D.T @ d2s @ _D
+
+
 def same_x_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
     """Gap of same-x pairs with its derivatives on their six DOFs (PAIR_ROLES), and the sliding."""
     v = u_full[pairs.dofs]  # (m, 6)

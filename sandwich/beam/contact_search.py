@@ -75,6 +75,9 @@ class ContactPairs:
     parent: ContactPairs | None = None
     parent_rows: np.ndarray | None = None
     half_width: np.ndarray | None = None  # (m,) closest-point: segments searched on each side
+    # a growing tip's cohesive pairs (same-x): their law and damage
+    # (:class:`sandwich.beam.cohesive.CohesiveZone`); None: contact pairs
+    cohesive: object | None = None
 
     @property
     def size(self) -> int:

@@ -85,7 +85,7 @@ def contact_correction_limit(
     tail = -SHIFT * smoothing
     alpha = 1.0
     for group in pairs:
-        if group.size == 0:
+        if group.size == 0 or group.cohesive is not None:  # cohesive pairs hold stiffness
             continue
         g, dg = gap_change(group, u_full, du_full)
         deep = (g > tail) & (g + dg < -bound)

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sandwich.beam.cohesive import carry_damage
 from sandwich.beam.core_basis import MAX_LEVEL
 from sandwich.beam.dofs import NODE_DOFS
 from sandwich.beam.mesh import BeamMesh
@@ -80,7 +81,8 @@ def transfer(u: np.ndarray, src: BeamModel, dst: BeamModel) -> np.ndarray:
 
     Both models discretise the same scene on the same mesh; only the core levels differ. The
     hierarchical order of the enrichment functions is the same for every level, so node i's
-    first k amplitudes mean the same in both.
+    first k amplitudes mean the same in both. A cohesive interface's damage goes with the
+    state (:func:`~sandwich.beam.cohesive.carry_damage`).
     """
     n = src.mesh.n_nodes
     full = src.expand(u)
@@ -95,6 +97,7 @@ def transfer(u: np.ndarray, src: BeamModel, dst: BeamModel) -> np.ndarray:
     free = np.zeros(dst.size)
     live = dst.dof_map.free >= 0
     free[dst.dof_map.free[live]] = dst.dof_map.sign[live] * out[live]
+    carry_damage(src, dst)
     return free
 
 

@@ -82,12 +82,16 @@ class BeamTip:
 
 
 def beam_tips(scene: object, model: BeamModel) -> list[BeamTip]:
-    """Every debond tip inside the beam (an end reaching a beam end is an open mouth)."""
+    """Every debond tip inside the beam (an end reaching a beam end is an open mouth).
+
+    Not the tips of a debond grown by a cohesive law: its interface ahead is untied (no
+    crack closure there); the law's tip positions are its columns (:mod:`.cohesive`).
+    """
     x = model.mesh.x
     tol = 1e-9 * scene.length
     out = []
     for i, d in enumerate(scene.debonds):
-        if d.end - d.start <= tol:
+        if d.end - d.start <= tol or (d.growth is not None and d.growth.cohesive):
             continue
         for tip, xt, step in (("start", d.start, -1), ("end", d.end, 1)):
             if xt <= tol or xt >= scene.length - tol:

@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from sandwich.beam.assembly import ReducedPattern, compiled_kernels, reduced_pattern, scatter_vector
+from sandwich.beam.cohesive import commit_damage, growth_columns
 from sandwich.beam.compiled_assembly import Assembled, CompiledAssembly
 from sandwich.beam.constraints import DofMap
 from sandwich.beam.contact_projection import forget_kinematics
@@ -223,7 +224,8 @@ class BeamModel:
         """History columns of a converged state: contact and G at the debond tips.
 
         Contact: :func:`~sandwich.beam.contact_summary.contact_columns`; G, G_I, G_II at every
-        debond tip (N/mm). Called by the path follower on every accepted state (after
+        debond tip (N/mm); each cohesive tip's position and process zone
+        (:func:`~sandwich.beam.cohesive.growth_columns`, of the committed damage). Called by the path follower on every accepted state (after
         :meth:`commit`, whose contact summary at the same ``u`` it takes), so that a run
         interrupted mid-path still writes them (:mod:`sandwich.beam.fracture`) and the
         solution's history does not evaluate them again.
@@ -231,12 +233,14 @@ class BeamModel:
         at = self.committed_u
         summary = (self.committed if at is not None and np.array_equal(at, u)
                    else self.contact_summary(u))
-        return {**contact_columns(summary), **release_columns(self, u, self.fracture_tips)}
+        return {**contact_columns(summary), **release_columns(self, u, self.fracture_tips),
+                **growth_columns(self)}
 
     def commit(self, u: np.ndarray, load_factor: float) -> None:
-        """Record the contact state of a converged step."""
+        """Record the contact state of a converged step and commit the cohesive damage."""
         self.committed = self.contact_summary(u)
         self.committed_u = np.array(u, dtype=float, copy=True)
+        commit_damage(self.pairs, self.expand(u))
         for s in self.committed.values():
             self.max_penetration_seen = max(self.max_penetration_seen, s.max_penetration)
             self.max_sliding_seen = max(self.max_sliding_seen, s.max_sliding)

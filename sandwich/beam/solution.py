@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from sandwich.beam.build import scene_gauss_orders
+from sandwich.beam.cohesive import GROWTH_COLUMNS
 from sandwich.beam.contact_summary import CONTACT_COLUMNS, contact_columns
 from sandwich.beam.fields import profile_columns, section_fields
 from sandwich.beam.fracture import beam_tips, column_names, release_columns
@@ -57,7 +58,8 @@ def beam_solution(
         max_slide = max(max_slide, contact["max_sliding"])
         extra = {**contact,
                  **({n: s.extra[n] for n in names} if names <= s.extra.keys()
-                    else release_columns(model, s.u, tips))}
+                    else release_columns(model, s.u, tips)),
+                 **{n: v for n, v in s.extra.items() if n.startswith(GROWTH_COLUMNS)}}
         history.append(StepRecord(step=s.step, load_factor=s.load_factor, probes=dict(s.probes),
                                   iterations=s.iterations, extra=extra))
     every = int(getattr(getattr(scene, "beam_model", None), "profile_every", 0) or 0)

@@ -61,6 +61,11 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
         "tolerance" in data["beam_model"])
     accuracy, beam_model = read_accuracy(r, data.get("accuracy", {}), beam_model,
                                          beam_tolerance_given)
+    if analysis is not None and getattr(analysis, "kind", None) == "linear":
+        for i, d in enumerate(debonds):
+            if d.growth is not None and d.growth.cohesive:
+                r.fail(f"debonds[{i}].growth.method", "a cohesive law is nonlinear (its damage "
+                       "grows along the path): it needs analysis kind = \"nonlinear\"")
     if not r.problems:
         check_mechanism(r, supports, debonds, length)
     if r.problems:

@@ -9,6 +9,7 @@ from typing import Any
 
 from sandwich.scene import (
     FACES,
+    GROWTH_METHODS,
     INTERFACES,
     SUPPORT_SITES,
     SUPPORT_TYPES,
@@ -25,6 +26,7 @@ __all__ = ["GEOMETRY_TOL", "check_mechanism", "read_debonds", "read_loads", "rea
            "read_supports"]
 
 GEOMETRY_TOL = 1e-9  # mm: two stations closer than this are the same station
+COHESIVE_KEYS = ("sigma_c", "tau_c", "zone", "stiffness")
 
 
 def _station(r: Reader, t: dict[str, Any], k: str, key: str, L: float | None) -> float | None:
@@ -86,17 +88,30 @@ def _toughness(r: Reader, t: dict[str, Any], key: str, a: float | None,
 
 def _growth(r: Reader, t: dict[str, Any], key: str, a: float | None, b: float | None,
             L: float | None, tough: Toughness | None) -> Growth | None:
-    """``growth = { step, max_length }`` of a debond (mm): grown by crack-length control."""
+    """``growth = { ... }`` of a debond: crack-length control or a cohesive law.
+
+    Crack-length: ``step``, ``max_length`` (mm). Cohesive: ``sigma_c`` (MPa, required),
+    ``tau_c`` (MPa, default σ_c √(G_IIc/G_Ic)), ``zone`` (mm), ``stiffness`` (N/mm³).
+    """
     if "growth" not in t:
         return None
     key = f"{key}.growth"
-    gt = r.table(t["growth"], key, ("step", "max_length"))
+    gt = r.table(t["growth"], key, ("method", "step", "max_length") + COHESIVE_KEYS)
     if gt is None:
         return None
     if "toughness" not in t:
         r.fail(key, "growth needs the debond's toughness = { GIc, GIIc } (N/mm): it decides "
                "at what load each tip advances")
         return None
+    method = r.choice(gt, "method", key, GROWTH_METHODS, default="crack-length")
+    if method == "cohesive":
+        return _cohesive_growth(r, gt, key, tough)
+    if method is None:
+        return None
+    for k in COHESIVE_KEYS:
+        if k in gt:
+            r.fail(f"{key}.{k}", "a cohesive law's key: it needs method = \"cohesive\" "
+                   "(crack-length control takes step and max_length)")
     step = r.number(gt, "step", key, default=2.0, positive=True)
     most = r.number(gt, "max_length", key, default=None, positive=True)
     if None in (step, a, b) or tough is None:
@@ -109,6 +124,33 @@ def _growth(r: Reader, t: dict[str, Any], key: str, a: float | None, b: float | 
         r.fail(f"{key}.step", f"{step:g} mm is more than a quarter of the beam ({L:g} mm)")
         return None
     return Growth(step, most)
+
+
+def _cohesive_growth(r: Reader, gt: dict[str, Any], key: str,
+                     tough: Toughness | None) -> Growth | None:
+    """The cohesive law's keys of ``growth`` (method = "cohesive")."""
+    for k in ("step", "max_length"):
+        if k in gt:
+            r.fail(f"{key}.{k}", "a crack-length control key: a cohesive tip moves with the "
+                   "law along the one path (zone bounds how far it may run)")
+    if "sigma_c" not in gt:
+        r.fail(key, "a cohesive law needs its opening strength sigma_c (MPa)")
+    sigma = r.number(gt, "sigma_c", key, default=None, positive=True)
+    tau = r.number(gt, "tau_c", key, default=None, positive=True)
+    zone = r.number(gt, "zone", key, default=None, positive=True)
+    stiffness = r.number(gt, "stiffness", key, default=None, positive=True)
+    if sigma is None or tough is None:
+        return None
+    if tau is None and "tau_c" not in gt:
+        tau = sigma * (tough.GIIc / tough.GIc) ** 0.5
+    if tau is None:
+        return None
+    floor = max(sigma**2 / (2 * tough.GIc), tau**2 / (2 * tough.GIIc))
+    if stiffness is not None and stiffness <= floor:
+        r.fail(f"{key}.stiffness", f"{stiffness:g} N/mm³ is below {floor:.4g} "
+               "(σ_c²/(2 G_Ic), τ_c²/(2 G_IIc)): the law would soften before its strength")
+        return None
+    return Growth(method="cohesive", sigma_c=sigma, tau_c=tau, zone=zone, stiffness=stiffness)
 
 
 def read_supports(r: Reader, arr: Any, L: float | None) -> list[Support]:
