@@ -225,8 +225,9 @@ class BeamModel:
 
         Contact: :func:`~sandwich.beam.contact_summary.contact_columns`; G, G_I, G_II at every
         debond tip (N/mm); each cohesive tip's position and process zone
-        (:func:`~sandwich.beam.cohesive.growth_columns`, of the committed damage). Called by the path follower on every accepted state (after
-        :meth:`commit`, whose contact summary at the same ``u`` it takes), so that a run
+        (:func:`~sandwich.beam.cohesive.growth_columns`, of the committed damage). Called by
+        the path follower on every accepted state (after :meth:`commit`, whose contact summary
+        and damage at the same ``u`` it takes), so that a run
         interrupted mid-path still writes them (:mod:`sandwich.beam.fracture`) and the
         solution's history does not evaluate them again.
         """
