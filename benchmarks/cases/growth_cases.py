@@ -26,6 +26,32 @@ def cantilever(step=10.0, max_length=80.0, a=40.0, gc=GC, until=0.5):
     return dataclasses.replace(sc, debonds=(d,))
 
 
+#: MPa: the cohesive strength of the face cantilever's interface. Its process zone, of the order
+#: of E_core G_c / σ_c² = 20 mm, spans a dozen elements at the default mesh, and is a fraction
+#: of the debond length (40 mm and up), where the closed form holds
+SIGMA_C = 0.01
+
+
+def cohesive_cantilever(a=40.0, gc=GC, sigma_c=SIGMA_C, zone=80.0, until=0.5, elements=240):
+    """The face cantilever, debond [0, a], grown by a cohesive law over ``zone`` mm ahead."""
+    sc = scene([("top", 0.0, 1.0)], a=a, until=until, core=1, elements=elements)
+    d = dataclasses.replace(sc.debonds[0], toughness=Toughness(gc, gc),
+                            growth=Growth(method="cohesive", sigma_c=sigma_c, tau_c=sigma_c,
+                                          zone=zone))
+    return dataclasses.replace(sc, debonds=(d,))
+
+
+def propagation_load(deflection, gc=GC):
+    """The face cantilever's load (N) while its debond grows at G = G_c, at the end deflection.
+
+    Beam theory with a root rotation: C(a) = 4 (a + χ t)³ / (E b t³) and
+    G = P²/(2b) dC/da = 6 P² (a + χ t)² / (b² E t³); eliminating a + χ t between G = G_c and
+    δ = C P gives P = √(4 b² t^{3/2} (E G_c / 6)^{3/2} / (E δ)), whatever χ.
+    """
+    return (4.0 * WIDTH**2 * T_FACE**1.5 * (E_FACE * gc / 6.0) ** 1.5
+            / (E_FACE * abs(deflection))) ** 0.5
+
+
 def onset_slope(gc=GC):
     """d(1/λ_c)/da of the face cantilever (1/(N mm)): √(6 / (G_c b² E t³))."""
     return (6.0 / (gc * WIDTH**2 * E_FACE * T_FACE**3)) ** 0.5

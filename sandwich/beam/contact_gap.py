@@ -104,7 +104,7 @@ def same_x_sliding(
     pairs: ContactPairs, u_full: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Sliding of same-x pairs with its gradient and Hessian on their six DOFs (PAIR_ROLES)."""
-    v = u_full[pairs.dofs]
+    v = u_full[pairs.dofs[:, :6]]
     s, ds, d2s = sliding_derivatives(v[:, 0] - v[:, 2], v[:, 1] - v[:, 3], 1.0 + v[:, 4],
                                      v[:, 5])
     return s, ds @ _D, _D.T @ d2s @ _D
@@ -112,7 +112,7 @@ def same_x_sliding(
 
 def same_x_kinematics(pairs: ContactPairs, u_full: np.ndarray) -> PairKinematics:
     """Gap of same-x pairs with its derivatives on their six DOFs (PAIR_ROLES), and the sliding."""
-    v = u_full[pairs.dofs]  # (m, 6)
+    v = u_full[pairs.dofs[:, :6]]  # (m, 6)
     Δu, Δw = v[:, 0] - v[:, 2], v[:, 1] - v[:, 3]
     a, c = 1.0 + v[:, 4], v[:, 5]  # slave tangent (1 + u_c,x, w_c,x)
     gap, dg, d2g = gap_derivatives(Δu, Δw, a, c, NORMAL_SIGN[pairs.interface])

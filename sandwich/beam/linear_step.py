@@ -50,8 +50,9 @@ def linear_contact_matrix(model: BeamModel, active: list[np.ndarray]) -> sp.csr_
         s_n = NORMAL_SIGN[pairs.interface]
         grad = np.array([0.0, s_n, 0.0, -s_n, 0.0, 0.0])  # ∂g_lin/∂(pair DOFs)
         blocks = (model.penalty * pairs.area * on)[:, None, None] * np.outer(grad, grad)
-        rows = np.repeat(pairs.dofs[:, :, None], 6, axis=2)
-        cols = np.repeat(pairs.dofs[:, None, :], 6, axis=1)
+        six = pairs.dofs[:, :6]  # (a cohesive pair's seventh, the face slope, not involved)
+        rows = np.repeat(six[:, :, None], 6, axis=2)
+        cols = np.repeat(six[:, None, :], 6, axis=1)
         K = K + sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(n, n))
     T = model.dof_map.T
     return (T.T @ K @ T).tocsr()

@@ -141,7 +141,7 @@ def run(
     solution = beam_solution(scene, model, states, nonlinear, converged, message, limit_points)
     solution.warnings[:0] = warnings  # the path's and auto's first, then the solution's own
     solution.extra["contact_penalty_reruns"] = len(raised)
-    solution.extra.update(growth_summary(scene, solution))
+    solution.extra.update(growth_summary(scene, solution, model))
     if level_warning(model, beam_tips(scene, model)):
         solution.extra["G_warning"] = level_warning(model, beam_tips(scene, model))
     solution.extra["faces"] = "stretch" if options["face_stretch"] else "paper"

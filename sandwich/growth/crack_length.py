@@ -49,8 +49,8 @@ GEOMETRY_MARGIN = 1e-9  # mm: a tip closer than this to a beam end is an open mo
 
 
 def growing(scene: Scene) -> bool:
-    """Whether any debond of ``scene`` asks to be grown."""
-    return any(d.growth is not None for d in scene.debonds)
+    """Whether any debond of ``scene`` asks to be grown by crack-length control."""
+    return any(d.growth is not None and not d.growth.cohesive for d in scene.debonds)
 
 
 def tip_column(debond: int, tip: str) -> str:

@@ -54,6 +54,9 @@ class ModelSpec:
     packages
         Packages and modules (paths under the project root) whose sources the result depends on
         (their digest is part of the identity).
+    cohesive
+        Whether the model grows a debond by a cohesive law; one without it grows a cohesive
+        debond by crack-length control (:func:`sandwich.growth.as_crack_length`).
     """
 
     name: str
@@ -61,6 +64,7 @@ class ModelSpec:
     options_table: str
     resolution_keys: tuple[str, ...]
     packages: tuple[str, ...]
+    cohesive: bool = False
 
     def options(self, scene: Scene) -> dict[str, object]:
         """The model's options table of ``scene`` as a plain dict."""
@@ -88,7 +92,7 @@ MODELS: dict[str, ModelSpec] = {
     "beam": ModelSpec("beam", _solve_beam, "beam_model",
                       ("elements", "grading", "core", "core_basis", "max_core_level",
                        "core_zones", "tolerance", "face_membrane", "faces", "contact_search"),
-                      ("sandwich/beam", *CONTRACT)),
+                      ("sandwich/beam", *CONTRACT), cohesive=True),
     "2d": ModelSpec("2d", _solve_2d, "reference2d",
                     ("level", "refine", "face_elements", "core_size", "face_size", "tip_size",
                      "half_model"),

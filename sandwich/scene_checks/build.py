@@ -66,6 +66,11 @@ def build_scene(data: dict[str, Any], fname: str, source: Path | None = None) ->
             if d.growth is not None and d.growth.cohesive:
                 r.fail(f"debonds[{i}].growth.method", "a cohesive law is nonlinear (its damage "
                        "grows along the path): it needs analysis kind = \"nonlinear\"")
+    methods = {d.growth.method for d in debonds if d.growth is not None}
+    if len(methods) > 1:
+        r.fail("debonds", "growing debonds use one method per scene (crack-length control "
+               "solves a path per length, a cohesive law grows along one path): got "
+               + " and ".join(sorted(methods)))
     if not r.problems:
         check_mechanism(r, supports, debonds, length)
     if r.problems:

@@ -1,0 +1,97 @@
+"""What a path with cohesive tips says of the growth: first growth, residual strength, arrest.
+
+A debond grown by a cohesive law (``growth = { method = "cohesive", … }``) grows along the one
+path: the model writes, per converged state, each tip's position ``tip_<debond>_<tip>`` (mm;
+where the interface is fully debonded up to) and the length of its process zone
+``process_zone_<debond>_<tip>`` (mm; damaged but still carrying traction). This module reads
+them (any model that writes them).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from sandwich.results import StepRecord
+from sandwich.scene import Growth, Scene
+
+METHOD = "cohesive law"
+CRACK_LENGTH_STEP = 2.0  # mm: the step of a cohesive debond grown by crack-length control
+MOVED = 1e-9  # mm: a tip that moved less than this has not grown
+
+
+def cohesive_tips(scene: Scene) -> list[tuple[int, str, float, float]]:
+    """(debond, tip, origin, far end of its span) of every cohesive tip of ``scene``."""
+    return [(s.debond, s.tip, s.origin, s.far) for s in scene.cohesive_spans()]
+
+
+def cohesive_summary(scene: Scene, rows: list[StepRecord], element: float | None = None
+                     ) -> tuple[dict[str, object], list[str]]:
+    """The ``debond_growth`` entry of a path with cohesive tips, and the warnings it needs.
+
+    ``first_growth_load``: the load of the first state where a tip has moved; ``residual
+    strength``: the largest load along the path (the load's sign that of the path's first
+    move), ``bounded`` whether the path came down from it; per tip its start, its position at
+    the path's end and the longest process zone; a warning where a tip's process zone came
+    within ``element`` mm (the element length at the span's end; default 0) of its span's end
+    (growth beyond it is not modelled: the interface there is tied).
+    """
+    tips = cohesive_tips(scene)
+    warnings: list[str] = []
+    if not tips or not rows:
+        return {}, warnings
+    sign = next((1.0 if r.load_factor > 0 else -1.0 for r in rows if r.load_factor != 0), 1.0)
+    moved = None
+    per_tip = {}
+    for debond, tip, origin, far in tips:
+        col = f"tip_{debond}_{tip}"
+        zone = f"process_zone_{debond}_{tip}"
+        seen = [r for r in rows if col in r.extra and r.extra[col] is not None]
+        if not seen:
+            continue
+        first = next((r for r in seen if abs(float(r.extra[col]) - origin) > MOVED), None)
+        if first is not None and (moved is None or first.step < moved.step):
+            moved = first
+        end = float(seen[-1].extra[col])
+        front = end + (1.0 if far > origin else -1.0) * float(seen[-1].extra.get(zone) or 0.0)
+        per_tip[f"{debond}_{tip}"] = {
+            "from": origin, "to": end, "span_end": far,
+            "grew_mm": abs(end - origin),
+            "longest_process_zone_mm": max(float(r.extra.get(zone) or 0.0) for r in seen),
+            "first_growth_step": None if first is None else first.step}
+        if abs(far - front) <= (element or 0.0) + MOVED:
+            warnings.append(f"debond {debond} {tip} tip reached the end of its cohesive span at "
+                            f"x = {far:g} mm: growth beyond it is not modelled (the interface "
+                            "there is tied); a longer growth zone would let it run on")
+    peak = max(rows, key=lambda r: sign * r.load_factor)
+    out: dict[str, object] = {
+        "method": METHOD,
+        "first_growth_load": None if moved is None else moved.load_factor,
+        "first_growth_step": None if moved is None else moved.step,
+        "residual_strength": peak.load_factor,
+        "residual_strength_step": peak.step,
+        "bounded": sign * rows[-1].load_factor < sign * peak.load_factor,
+        "tips": per_tip,
+    }
+    return out, warnings
+
+
+def cohesive_growing(scene: Scene) -> bool:
+    """Whether a debond of ``scene`` grows by a cohesive law."""
+    return any(d.growth is not None and d.growth.cohesive for d in scene.debonds)
+
+
+def as_crack_length(scene: Scene, step: float = CRACK_LENGTH_STEP) -> Scene:
+    """``scene`` with its cohesive debonds grown by crack-length control instead.
+
+    For a model without the cohesive law (the 2D reference): the same toughness, tips advanced
+    by ``step`` mm, as far as the cohesive spans reach (:mod:`sandwich.growth.crack_length`).
+    """
+    reach: dict[int, float] = {}
+    for s in scene.cohesive_spans():
+        reach[s.debond] = reach.get(s.debond, 0.0) + abs(s.far - s.origin)
+    debonds = []
+    for i, d in enumerate(scene.debonds):
+        if d.growth is not None and d.growth.cohesive:
+            d = dataclasses.replace(d, growth=Growth(step, d.length + reach.get(i, 0.0)))
+        debonds.append(d)
+    return dataclasses.replace(scene, debonds=tuple(debonds))

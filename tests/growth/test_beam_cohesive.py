@@ -1,0 +1,66 @@
+"""Growth by the beam's cohesive law, against the closed form and the tied interface.
+
+The face cantilever of ``benchmarks.cases.growth_cases`` (an end force on the top face at an
+open mouth, debond [0, 40], the faces clamped at x = 200), driven by the end deflection δ:
+while the debond grows at G = G_c, beam theory with a root rotation gives the load
+P = √(4 b² t^{3/2} (E G_c / 6)^{3/2} / (E δ)) whatever the root rotation
+(:func:`~benchmarks.cases.growth_cases.propagation_load`). A cohesive zone reproduces it once
+its process zone is small against the debond; undamaged, the cohesive pairs are the tie as
+their stiffness grows (the same mesh, the tied model as reference).
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from benchmarks.cases.growth_cases import cohesive_cantilever, propagation_load
+from sandwich.beam.solve import run
+from sandwich.scene import Growth, Toughness
+
+
+@pytest.fixture(scope="module")
+def grown():
+    return run(cohesive_cantilever()).solution
+
+
+def test_propagation_follows_the_closed_form(grown):
+    assert grown.converged, grown.message
+    # from 15 mm past the initial tip (where the process zone has formed: up to 3.2 % above
+    # the closed form before) to one process zone before the span's end
+    rows = [r for r in grown.history if 55.0 <= r.extra["tip_0_end"] <= 105.0]
+    assert len(rows) >= 10  # the tip crosses the range in many steps
+    ratio = np.array([r.load_factor / propagation_load(r.probes["w0"]) for r in rows])
+    assert np.all(np.abs(ratio - 1.0) < 0.03), ratio
+    # the process zone's share shrinks as the debond grows: the ratio falls towards 1
+    assert ratio[-1] < ratio[0]
+
+
+def test_tip_moves_forward_only_and_the_summary_says_where_it_went(grown):
+    tips = np.array([r.extra["tip_0_end"] for r in grown.history])
+    assert np.all(np.diff(tips) >= 0.0)
+    summary = grown.extra["debond_growth"]
+    assert summary["method"] == "cohesive law"
+    tip = summary["tips"]["0_end"]
+    assert tip["from"] == 40.0 and tip["to"] == pytest.approx(tips[-1])
+    assert summary["residual_strength"] >= summary["first_growth_load"] > 0.0
+    # the process zone reached the span's end (x = 120): the run says growth stops there
+    assert any("end of its cohesive span" in w for w in grown.warnings)
+    assert "G_0_end" not in grown.history[-1].extra  # no crack closure on a cohesive tip
+
+
+def test_undamaged_cohesive_pairs_are_the_tie_as_their_stiffness_grows():
+    sc = cohesive_cantilever(until=0.05)
+    tied = dataclasses.replace(sc.debonds[0], toughness=None, growth=None)
+    changes = []
+    for stiffness in (None, 2.2e7):  # the default, 1000 × it
+        strong = dataclasses.replace(sc.debonds[0], toughness=Toughness(1e3, 1e3),
+                                     growth=Growth(method="cohesive", sigma_c=1e3, tau_c=1e3,
+                                                   zone=80.0, stiffness=stiffness))
+        a = run(dataclasses.replace(sc, debonds=(strong,)))
+        b = run(dataclasses.replace(sc, debonds=(tied,)), model_options={"mesh": a.model.mesh})
+        assert a.solution.extra["debond_growth"]["first_growth_load"] is None
+        changes.append(a.solution.history[-1].load_factor / b.solution.history[-1].load_factor
+                       - 1.0)
+    assert -0.005 < changes[0] < 0.0  # the law's compliance 1/K
+    assert abs(changes[1]) < 1e-4
