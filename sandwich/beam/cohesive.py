@@ -218,9 +218,10 @@ def cohesive_groups(scene: object, x: np.ndarray, core_modulus: float) -> list:
         nb = nodes[tip] + span.direction
         area[tip] = 0.5 * scene.width * (abs(x[nb] - x[nodes[tip]]) if 0 <= nb < x.size
                                          else 0.0)
-        floor = max(g.sigma_c**2 / (2 * t.GIc), g.tau_c**2 / (2 * t.GIIc))
+        tau = g.tau_c if g.tau_c is not None else g.sigma_c * (t.GIIc / t.GIc) ** 0.5
+        floor = max(g.sigma_c**2 / (2 * t.GIc), tau**2 / (2 * t.GIIc))
         stiffness = g.stiffness or default_stiffness(core_modulus, scene.core.thickness, floor)
-        law = CohesiveLaw(stiffness, g.sigma_c, g.tau_c, t.GIc, t.GIIc, t.eta)
+        law = CohesiveLaw(stiffness, g.sigma_c, tau, t.GIc, t.GIIc, t.eta)
         zone = CohesiveZone(law, span.debond, span.tip, span.origin, span.direction,
                             np.zeros((nodes.size, 2)), float(scene.width))
         slope = global_dof(nodes, "w_t,x" if span.interface == "top" else "w_b,x")
