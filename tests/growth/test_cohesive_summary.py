@@ -1,0 +1,40 @@
+"""A cohesive path's summary and the 2D model's stand-in, on hand-made scenes and rows."""
+
+import dataclasses
+
+import pytest
+
+from benchmarks.cases.growth_cases import cohesive_cantilever
+from sandwich.growth import as_crack_length, cohesive_growing, cohesive_summary, growing
+from sandwich.results import StepRecord
+
+
+def _row(step, lam, tip, zone):
+    return StepRecord(step=step, load_factor=lam, probes={}, iterations=1,
+                      extra={"tip_0_end": tip, "process_zone_0_end": zone})
+
+
+def test_summary_reads_first_growth_residual_strength_and_the_span_end():
+    sc = cohesive_cantilever(zone=20.0)  # span [40, 60]
+    rows = [_row(0, 0.0, 40.0, 0.0), _row(1, 0.1, 40.0, 3.0), _row(2, 0.15, 40.0, 5.0),
+            _row(3, 0.12, 45.0, 5.0), _row(4, 0.11, 55.0, 5.0)]
+    out, warnings = cohesive_summary(sc, rows, element=0.5)
+    assert out["first_growth_load"] == 0.12 and out["first_growth_step"] == 3
+    assert out["residual_strength"] == 0.15 and out["bounded"]
+    tip = out["tips"]["0_end"]
+    assert (tip["from"], tip["to"], tip["grew_mm"]) == (40.0, 55.0, 15.0)
+    assert tip["longest_process_zone_mm"] == 5.0
+    assert len(warnings) == 1 and "x = 60 mm" in warnings[0]  # 55 + 5 reaches the span's end
+    out, warnings = cohesive_summary(sc, rows[:3], element=0.5)
+    assert out["first_growth_load"] is None and not warnings
+
+
+def test_a_model_without_the_law_grows_the_same_debond_by_crack_length():
+    sc = cohesive_cantilever(zone=30.0)
+    assert cohesive_growing(sc) and not growing(sc)
+    stand_in = as_crack_length(sc)
+    assert growing(stand_in) and not cohesive_growing(stand_in)
+    d = stand_in.debonds[0]
+    assert d.toughness == sc.debonds[0].toughness
+    assert d.growth.max_length == pytest.approx(40.0 + 30.0)
+    assert dataclasses.replace(d, growth=None) == dataclasses.replace(sc.debonds[0], growth=None)
