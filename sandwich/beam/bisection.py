@@ -55,7 +55,7 @@ def bisected_state(u: np.ndarray, src: BeamModel, dst: BeamModel) -> np.ndarray:
     free = np.zeros(dst.size)
     live = dst.dof_map.free >= 0
     free[dst.dof_map.free[live]] = dst.dof_map.sign[live] * out[live]
-    carry_damage(src, dst)
+    carry_damage(src, dst, u)
     return free
 
 

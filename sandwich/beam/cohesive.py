@@ -12,11 +12,12 @@ node's area A and its own damage:
 
     g_± = g ± θ l/(2√3),
     f = Σ± (A/2) [t_n(g_±, s) ∂g_± + t_s(g_±, s) ∂s] − A p(g) ∂g,
-    K = Σ± (A/2) [T_nn ∂g_± ∂g_±ᵀ + T_ns (∂g_± ∂sᵀ + ∂s ∂g_±ᵀ) + T_ss ∂s ∂sᵀ
+    K = Σ± (A/2) [T_nn ∂g_± ∂g_±ᵀ + T_ns ∂g_± ∂sᵀ + T_sn ∂s ∂g_±ᵀ + T_ss ∂s ∂sᵀ
                   + t_n ∂²g + t_s ∂²s] − A p'(g) ∂g ∂gᵀ − A p ∂²g,
 
-p(g) the contact law of the debonded stretches on the node's gap (so a fully damaged pair is
-the contact of a debond), T the law's tangent. Undamaged, θ's stiffness is K A l²/12. Node-wise
+p(g) the contact law of the debonded stretches on the node's gap (so a fully damaged pair is the
+contact of a debond), T the law's tangent (not symmetric where the damage grows under a changing
+mode mix: :mod:`sandwich.beam.unsymmetric`). Undamaged, θ's stiffness is K A l²/12. Node-wise
 (trapezoidal) integration along x, as is usual for cohesive interfaces: it keeps the tractions
 free of the oscillations a Gauss rule gives on a stiff interface. Undamaged, the pairs are the
 tie up to the compliance 1/K: on the face cantilever's mesh the load at a deflection is 0.31 %
@@ -26,8 +27,9 @@ below the tied model's at the default K, 5e-6 below at 1000 × it
 The damage D of each point (the history) is committed at every converged state
 (:meth:`sandwich.beam.model.BeamModel.commit`); within an increment the law works from the
 committed damage, so a rejected or retried step leaves no trace. A state carried onto another
-model (core levels raised, elements split) takes the damage with it by x
-(:func:`carry_damage`).
+model (core levels raised, elements split) takes its own damage with it by x
+(:func:`carry_damage`; the model keeps each committed state's damage,
+:meth:`sandwich.beam.model.BeamModel.committed_damage`).
 """
 
 from __future__ import annotations
@@ -103,8 +105,8 @@ def cohesive_response(
     tn, ts = t[..., 0], t[..., 1]
     f = np.einsum("mp,mpi->mi", half[:, None] * tn, dg) + (half * ts.sum(1))[:, None] * ds
     K = np.einsum("mp,mpi,mpj->mij", half[:, None] * T[..., 0, 0], dg, dg)
-    gs = np.einsum("mp,mpi,mj->mij", half[:, None] * T[..., 0, 1], dg, ds)
-    K += gs + np.swapaxes(gs, 1, 2)
+    K += np.einsum("mp,mpi,mj->mij", half[:, None] * T[..., 0, 1], dg, ds)
+    K += np.einsum("mp,mi,mpj->mij", half[:, None] * T[..., 1, 0], ds, dg)
     K += (half * T[..., 1, 1].sum(1))[:, None, None] * ds[:, :, None] * ds[:, None, :]
     K += (half * tn.sum(1))[:, None, None] * hg + (half * ts.sum(1))[:, None, None] * hs
     # the contact of the node's gap, as on a debonded stretch
@@ -137,23 +139,27 @@ def commit_damage(groups: list, u_full: np.ndarray) -> None:
             pairs.cohesive.damage[:] = pair_damage(pairs, u_full)
 
 
-def carry_damage(source: object, target: object) -> None:
-    """Give ``target``'s cohesive pairs the committed damage of ``source``'s, by x.
+def carry_damage(source: object, target: object, u: np.ndarray | None = None) -> None:
+    """Give ``target``'s cohesive pairs the damage of ``source``'s, by x.
 
-    Both are :class:`~sandwich.beam.model.BeamModel`; a node of ``target`` between two of
-    ``source``'s (elements split in two) takes the larger damage of the two, so that no
-    damage is lost and the carried state is never less debonded.
+    Both are :class:`~sandwich.beam.model.BeamModel`. The damage ``source`` committed at its
+    state ``u`` where it committed that state (a path taken again from an earlier state after
+    the core levels were raised starts from that state's damage, not from the latest), else
+    its latest. A node of ``target`` between two of ``source``'s (elements split in two)
+    takes the larger damage of the two, so that no damage is lost.
     """
+    kept = None if u is None else source.committed_damage(u)
     x_s, x_t = source.mesh.x, target.mesh.x
     for t in target.pairs:
         if t.cohesive is None:
             continue
-        match = [s for s in source.pairs if s.cohesive is not None
+        match = [(k, s) for k, s in enumerate(source.pairs) if s.cohesive is not None
                  and (s.cohesive.debond, s.cohesive.tip) == (t.cohesive.debond, t.cohesive.tip)]
         if not match:
             continue
-        s = match[0]
-        xs, ds = x_s[s.nodes], s.cohesive.damage
+        k, s = match[0]
+        xs = x_s[s.nodes]
+        ds = s.cohesive.damage if kept is None else kept[k]
         order = np.argsort(xs)
         xs, ds = xs[order], ds[order]
         xt = x_t[t.nodes]
@@ -186,7 +192,7 @@ def growth_columns(model: object) -> dict[str, float]:
         damaged = float(dist[hurt > 0].max()) if np.any(hurt > 0) else reach
         key = f"{zone.debond}_{zone.tip}"
         out[f"tip_{key}"] = float(zone.origin + zone.direction * reach)
-        out[f"process_zone_{key}"] = max(damaged - reach, 0.0)
+        out[f"process_zone_{key}"] = max(damaged - reach, 0.0) + 0.0  # never −0.0
     return out
 
 

@@ -29,9 +29,9 @@ and D = max(D_committed, d(δ)): damage only grows, and unloading goes linearly 
 
 The local tangent ∂(t_n, t_s)/∂(g, s) is computed by complex-step differentiation of the same
 expressions (exact to round-off, with the damage growing where the trial damage exceeds the
-committed one). It is symmetric where the mode mix does not change along the increment; the
-caller symmetrises it, since the structure's tangent is factorised by a symmetric LDLᵀ (Newton
-then converges linearly, not quadratically, while the mix changes inside a damaging pair).
+committed one). It is symmetric where the mode mix does not change along the increment, not
+where it does: the beam model then solves with the whole matrix
+(:mod:`sandwich.beam.unsymmetric`).
 """
 
 from __future__ import annotations
@@ -109,7 +109,7 @@ class CohesiveLaw:
 
     def response(self, g: np.ndarray, s: np.ndarray, committed: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Tractions (m, 2), symmetrised tangent (m, 2, 2), damage (m,) and its gradient (m, 2).
+        """Tractions (m, 2), tangent (m, 2, 2), damage (m,) and its gradient (m, 2).
 
         The tangent ∂t/∂(g, s) and the gradient ∂D/∂(g, s) by complex steps in g and in s
         (see the module docstring).
@@ -124,7 +124,7 @@ class CohesiveLaw:
         T = np.stack([dg, ds], axis=-1)  # T[:, i, j] = ∂t_i / ∂(g, s)_j
         dD = np.stack([self.damage(gc, s.astype(complex), committed).imag,
                        self.damage(g.astype(complex), sc, committed).imag], axis=-1) / STEP
-        return (t, 0.5 * (T + np.swapaxes(T, -1, -2)), self.damage(g, s, committed).real, dD)
+        return t, T, self.damage(g, s, committed).real, dD
 
 
 STIFFNESS_FACTOR = 1e3  # default K = STIFFNESS_FACTOR · Q_z / h_c

@@ -42,6 +42,7 @@ from sandwich.beam.local_responses import (
     reference_tangent_blocks,
 )
 from sandwich.beam.mesh import BeamMesh
+from sandwich.beam.unsymmetric import UnsymmetricFactorization, skew_split
 
 PENETRATION_BOUND = 1e-3  # allowed penetration / face thickness
 
@@ -89,6 +90,8 @@ class BeamModel:
     # the state whose contact ``committed`` summarises, and the last evaluation: not copied by
     # dataclasses.replace (a model with other DOFs starts without them)
     committed_u: np.ndarray | None = field(default=None, init=False, repr=False)
+    # (u, per contact group the cohesive damage or None) of every committed state (cohesive)
+    damage_history: list = field(default_factory=list, init=False, repr=False)
     last_evaluation: Evaluation | None = field(default=None, init=False, repr=False)
     use_kernels = True  # class attribute, not a field: False forces the NumPy reference path
 
@@ -211,7 +214,18 @@ class BeamModel:
         return float(np.finfo(float).eps * np.linalg.norm(product))
 
     def factorize(self, K: sp.spmatrix) -> object:
-        """Envelope LDLᵀ of the tangent with its inertia (:mod:`sandwich.beam.factorisation`)."""
+        """Envelope LDLᵀ of the tangent with its inertia (:mod:`sandwich.beam.factorisation`).
+
+        A tangent that is not symmetric (cohesive pairs damaging under a changing mode mix) is
+        solved by its LU, with the inertia of its symmetric part
+        (:mod:`sandwich.beam.unsymmetric`).
+        """
+        if any(p.cohesive is not None for p in self.pairs):
+            K = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
+            sym = skew_split(K)
+            if sym is not None:
+                return UnsymmetricFactorization(K, self.factorisations.factorize(sym,
+                                                                                 self.pattern))
         return self.factorisations.factorize(K, self.pattern)
 
     def probe_vector(self, name: str) -> np.ndarray:
@@ -241,10 +255,25 @@ class BeamModel:
         """Record the contact state of a converged step and commit the cohesive damage."""
         self.committed = self.contact_summary(u)
         self.committed_u = np.array(u, dtype=float, copy=True)
-        commit_damage(self.pairs, self.expand(u))
+        if any(p.cohesive is not None for p in self.pairs):
+            commit_damage(self.pairs, self.expand(u))
+            self.damage_history.append((self.committed_u, [
+                None if p.cohesive is None else p.cohesive.damage.copy() for p in self.pairs]))
         for s in self.committed.values():
             self.max_penetration_seen = max(self.max_penetration_seen, s.max_penetration)
             self.max_sliding_seen = max(self.max_sliding_seen, s.max_sliding)
+
+    @property
+    def path_dependent(self) -> bool:
+        """Whether the model has history (cohesive damage): its state is not (u, λ) alone."""
+        return any(p.cohesive is not None for p in self.pairs)
+
+    def committed_damage(self, u: np.ndarray) -> list | None:
+        """Per contact group the cohesive damage committed at the state ``u`` (None: not one)."""
+        for at, damage in reversed(self.damage_history):
+            if at.shape == np.shape(u) and np.array_equal(at, u):
+                return damage
+        return None
 
     def correction_limit(self, u: np.ndarray, du: np.ndarray) -> float:
         """Largest fraction α ≤ 1 of the correction ``du`` from ``u`` this model trusts.

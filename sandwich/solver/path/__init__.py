@@ -41,7 +41,9 @@ there and its load tangent ``t = K₀⁻¹ f_ref``:
   a branch a step left is walked to bound its top (:mod:`.rescue`);
 - after each accepted step, a bifurcation or load extremum inside it is located
   (:mod:`.critical_points`), and a path that retraces its own branch stops
-  (:class:`~.guards.ReturnGuard`).
+  (:class:`~.guards.ReturnGuard`), unless the system says it is path-dependent (optional
+  ``system.path_dependent`` true: a state with history, such as a damaging interface, is not
+  its (u, λ) alone, and unloading past a snap-back passes near states it was at before).
 
 ψ (:attr:`PathOptions.arc_load_weight` × ``‖K(0)⁻¹ f_ref‖``) converts λ into displacement units,
 so in the linear range the λ and u parts of the arc weigh the same.

@@ -111,7 +111,10 @@ class PathFollower(RescueSteps, CriticalPoints, StepSizeControl, SystemSwitch):
                 return self.finish(False, (
                     f"step {step}: the path came back through zero load (λ {last.load_factor:.6g}"
                     f" → {trial.load_factor:.6g}); stopped there (stop_at_load_reversal)"))
-            back = self.return_guard.retracing(self.states)
+            # a path-dependent system's states are not its (u, λ) alone: an unloading past a
+            # snap-back passes near states it was at before, with another history
+            back = ("" if getattr(self.system, "path_dependent", False)
+                    else self.return_guard.retracing(self.states))
             if back:
                 return self.finish(False, back)
             try:
