@@ -28,12 +28,14 @@ def cohesive_summary(scene: Scene, rows: list[StepRecord], element: float | None
                      ) -> tuple[dict[str, object], list[str]]:
     """The ``debond_growth`` entry of a path with cohesive tips, and the warnings it needs.
 
-    ``first_growth_load``: the load of the first state where a tip has moved; ``residual
-    strength``: the largest load along the path (the load's sign that of the path's first
-    move), ``bounded`` whether the path came down from it; per tip its start, its position at
-    the path's end and the longest process zone; a warning where a tip's process zone came
-    within ``element`` mm (the element length at the span's end; default 0) of its span's end
-    (growth beyond it is not modelled: the interface there is tied).
+    ``first_growth_load``: the load of the first state where a tip has moved; a tip whose
+    process zone comes within ``element`` mm (the element length at the span's end; default 0)
+    of its span's end has run out of modelled interface (the interface beyond is tied), and
+    the path from there on is not the growing debond's: ``residual_strength`` is the largest
+    load along the path before that (the load's sign that of the path's first move;
+    ``span_end_step`` the first state at a span's end, ``bounded`` whether the load came down
+    from its largest before it), with a warning. Per tip its start, its position at the path's
+    end and the longest process zone.
     """
     tips = cohesive_tips(scene)
     warnings: list[str] = []
@@ -41,35 +43,44 @@ def cohesive_summary(scene: Scene, rows: list[StepRecord], element: float | None
         return {}, warnings
     sign = next((1.0 if r.load_factor > 0 else -1.0 for r in rows if r.load_factor != 0), 1.0)
     moved = None
+    stop = len(rows)  # rows[:stop]: the growth the spans model
     per_tip = {}
     for debond, tip, origin, far in tips:
         col = f"tip_{debond}_{tip}"
         zone = f"process_zone_{debond}_{tip}"
-        seen = [r for r in rows if col in r.extra and r.extra[col] is not None]
+        towards = 1.0 if far > origin else -1.0
+        seen = [(i, r) for i, r in enumerate(rows) if r.extra.get(col) is not None]
         if not seen:
             continue
-        first = next((r for r in seen if abs(float(r.extra[col]) - origin) > MOVED), None)
+        first = next((r for _, r in seen if abs(float(r.extra[col]) - origin) > MOVED), None)
         if first is not None and (moved is None or first.step < moved.step):
             moved = first
-        end = float(seen[-1].extra[col])
-        front = end + (1.0 if far > origin else -1.0) * float(seen[-1].extra.get(zone) or 0.0)
+        end = float(seen[-1][1].extra[col])
+        at_end = next((i for i, r in seen if abs(far - float(r.extra[col]) - towards * float(
+            r.extra.get(zone) or 0.0)) <= (element or 0.0) + MOVED), None)
         per_tip[f"{debond}_{tip}"] = {
             "from": origin, "to": end, "span_end": far,
             "grew_mm": abs(end - origin),
-            "longest_process_zone_mm": max(float(r.extra.get(zone) or 0.0) for r in seen),
+            "longest_process_zone_mm": max(float(r.extra.get(zone) or 0.0) for _, r in seen),
             "first_growth_step": None if first is None else first.step}
-        if abs(far - front) <= (element or 0.0) + MOVED:
+        if at_end is not None:
+            stop = min(stop, at_end)
             warnings.append(f"debond {debond} {tip} tip reached the end of its cohesive span at "
-                            f"x = {far:g} mm: growth beyond it is not modelled (the interface "
-                            "there is tied); a longer growth zone would let it run on")
-    peak = max(rows, key=lambda r: sign * r.load_factor)
+                            f"x = {far:g} mm (step {rows[at_end].step}): growth beyond it is not "
+                            "modelled (the interface there is tied), and the residual strength "
+                            "is the largest load before; a longer growth zone would let it run "
+                            "on")
+    modelled = rows[:max(stop, 1)]
+    peak = max(modelled, key=lambda r: sign * r.load_factor)
     out: dict[str, object] = {
         "method": METHOD,
-        "first_growth_load": None if moved is None else moved.load_factor,
+        "first_growth_load": None if moved is None or moved.step > modelled[-1].step
+        else moved.load_factor,
         "first_growth_step": None if moved is None else moved.step,
         "residual_strength": peak.load_factor,
         "residual_strength_step": peak.step,
-        "bounded": sign * rows[-1].load_factor < sign * peak.load_factor,
+        "bounded": sign * modelled[-1].load_factor < sign * peak.load_factor,
+        "span_end_step": None if stop == len(rows) else rows[stop].step,
         "tips": per_tip,
     }
     return out, warnings
