@@ -75,6 +75,16 @@ class _StepBar:
 
 def growth_line(growth: dict) -> str:
     """What a growth run found, in one line (summary ``debond_growth`` of a growth run)."""
+    if "tips" in growth:  # a cohesive law's path
+        moved = "; ".join(f"tip {k} {t['from']:g} -> {t['to']:.4g} mm (process zone up to "
+                          f"{t['longest_process_zone_mm']:.3g} mm)"
+                          for k, t in growth["tips"].items())
+        if growth.get("first_growth_load") is None:
+            return f"  growth (cohesive law): no tip moved; {moved}"
+        at_least = "" if growth["bounded"] else "at least "
+        return (f"  growth (cohesive law): first at load factor "
+                f"{growth['first_growth_load']:.6g}, residual strength {at_least}"
+                f"{growth['residual_strength']:.6g}; {moved}")
     if growth.get("first_growth_load") is None:
         return f"  growth: none ({growth['stopped']})"
     at_least = "" if growth["bounded"] else "at least "
@@ -161,7 +171,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     grown = isinstance(growth, dict) and "method" in growth
     if grown:
         say(args, growth_line(growth))
-    say(args, accuracy_line(f"{args.model} (the last length's path)" if grown else args.model,
+    lengths = grown and "tips" not in growth  # crack-length control: a path per length
+    say(args, accuracy_line(f"{args.model} (the last length's path)" if lengths else args.model,
                             sol))
     say(args, f"results in {out}/ ({written_files(out)})")
     for w in sol.warnings if mpi_rank() == 0 else ():
