@@ -1,11 +1,12 @@
 """The growth figures and table of a comparison whose scene grows debonds.
 
 A growth run's history is its envelope (:mod:`sandwich.growth`): the onset states, one per
-debond length, with the tip positions. Per growing debond, ``growth_<i>.png`` draws both
-models' onset load and onset deflection against the debond's length (the knock-down of the
-growth load), ``growth_tips_<i>.png`` the tip positions against the load along the whole
-growth history; ``growth.csv`` holds each model's first growth load and residual strength (N)
-and their ratio to the 2D model's.
+debond length, with the tip positions; a cohesive law's run (the beam) is one path, whose states
+past the first growth give the load at each length the same way. Per growing debond,
+``growth_<i>.png`` draws both models' onset load and onset deflection against the debond's
+length (the knock-down of the growth load), ``growth_tips_<i>.png`` the tip positions against
+the load along the whole growth history; ``growth.csv`` holds each model's first growth load and
+residual strength (N) and their ratio to the 2D model's.
 """
 
 from __future__ import annotations
@@ -43,15 +44,23 @@ def growth_figures(scene: Scene, solutions: dict[str, Solution], out_dir: Path,
     for i in growing:
         start, end = tip_column(i, "start"), tip_column(i, "end")
         loads, defl, tips = [], [], []
+        d = scene.debonds[i]
         for model, s in runs.items():
             onsets = onset_rows(s.history)
+            if "tips" in s.extra["debond_growth"]:  # a cohesive law: its path once grown
+                onsets = [r for r in s.history
+                          if r.extra.get(end, d.end) - r.extra.get(start, d.start)
+                          > d.length + 1e-9]
             if not onsets:
                 continue
-            length = np.array([r.extra[end] - r.extra[start] for r in onsets])
+            length = np.array([r.extra.get(end, d.end) - r.extra.get(start, d.start)
+                               for r in onsets])
             loads.append(Curve(model, length, scale * np.array([r.load_factor for r in onsets])))
             defl.append(Curve(model, length, np.array([r.probes[probe] for r in onsets])))
             lam = scale * np.array([r.load_factor for r in s.history])
             for col in (start, end):
+                if not any(col in r.extra for r in s.history):
+                    continue  # an open mouth
                 tips.append(Curve(f"{model} {col.rsplit('_', 1)[1]} tip", lam,
                                   np.array([r.extra.get(col, np.nan) for r in s.history])))
         if not loads:
@@ -77,7 +86,7 @@ def _growth_table(runs: dict[str, Solution], path: Path, scale: float) -> Path:
     ref = runs.get(REFERENCE)
     for model, s in runs.items():
         g = s.extra["debond_growth"]
-        row = {"model": model, "stages": g["stages"],
+        row = {"model": model, "method": g["method"], "stages": g.get("stages", ""),
                "first_growth_load_N": _n(g["first_growth_load"], scale),
                "residual_strength_N": _n(g["residual_strength"], scale),
                "residual_strength_bounded": g["bounded"], "wall_seconds": s.wall_seconds}

@@ -77,3 +77,18 @@ def test_solve_prints_the_growth_and_writes_the_tips(tmp_path: Path, capsys):
     growth = summary["debond_growth"]
     assert growth["method"] == "cohesive law"
     assert growth["residual_strength"] >= growth["first_growth_load"] > 0
+
+
+def test_compare_draws_the_cohesive_path_as_a_growth_envelope(tmp_path: Path):
+    from sandwich.beam import solve
+    from sandwich.compare.growth import growth_figures
+    from sandwich.scene_file import load_scene
+
+    path = tmp_path / "peel.toml"
+    path.write_text(SCENE)
+    scene = load_scene(path)
+    figures, tables = growth_figures(scene, {"beam": solve(scene)}, tmp_path, 1.0)
+    assert [f.name for f in figures] == ["growth_0.png", "growth_tips_0.png"]
+    with open(tmp_path / "growth.csv") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["method"] == "cohesive law" and float(row["residual_strength_N"]) > 0
