@@ -64,3 +64,24 @@ def test_undamaged_cohesive_pairs_are_the_tie_as_their_stiffness_grows():
                        - 1.0)
     assert -0.005 < changes[0] < 0.0  # the law's compliance 1/K
     assert abs(changes[1]) < 1e-4
+
+
+def test_cohesive_path_follows_the_crack_length_envelope(grown):
+    """At each crack-length onset's deflection the cohesive path carries the onset load.
+
+    The beam's own envelope, G from the crack closure at fixed lengths: the established check
+    of propagation codes against the static G.
+    """
+    from benchmarks.cases.growth_cases import cantilever
+    from sandwich.beam import solve
+    from sandwich.growth import grow, onset_rows
+
+    onsets = onset_rows(grow(cantilever(step=10.0, max_length=100.0), solve).history)[1:]
+    tip = np.array([r.extra["tip_0_end"] for r in grown.history])
+    moving = tip > tip[0]
+    d = np.array([abs(r.probes["w0"]) for r in grown.history])[moving]
+    lam = np.array([r.load_factor for r in grown.history])[moving]
+    ratio = [np.interp(abs(o.probes["w0"]), d, lam) / o.load_factor for o in onsets
+             if d[0] <= abs(o.probes["w0"]) <= d[-1]]
+    assert len(ratio) >= 4
+    assert np.allclose(ratio, 1.0, atol=0.03), ratio
