@@ -47,7 +47,10 @@ class UnsymmetricFactorization:
     def __init__(self, K: sp.csr_matrix, sym: object) -> None:
         self.sym = sym
         try:
-            self.lu = spla.splu(sp.csc_matrix(K))
+            # the model's node-wise numbering keeps the matrix banded: its own order fills
+            # less than SuperLU's column orderings (c3 at level 3, 12 065 DOFs: 0.08 s and
+            # 2.2 M factor entries against COLAMD's 0.22 s and 3.3 M)
+            self.lu = spla.splu(sp.csc_matrix(K), permc_spec="NATURAL")
         except RuntimeError as exc:  # SuperLU: "Factor is exactly singular"
             raise SingularTangentError(f"the tangent is singular ({exc})") from exc
 

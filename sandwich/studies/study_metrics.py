@@ -113,9 +113,10 @@ def case_metrics(scene: Scene, sol: Solution) -> dict[str, object]:
     grown = isinstance(growth, dict) and "method" in growth
     out["first_growth_load"] = _finite(growth["first_growth_load"]) if grown else None
     out["residual_strength"] = _finite(growth["residual_strength"]) if grown else None
-    if grown:  # the history is the growth envelope: no path to a target
-        out["load_at_until"] = None
+    if grown:  # residual strength: what the damaged panel carries
         out["capacity"] = out["residual_strength"]
+        if "tips" not in growth:  # crack-length control: the history is the envelope, no path
+            out["load_at_until"] = None
     out["peak_sigma_zz"] = _signed_peak(sol, ("sigma_zz_top", "sigma_zz_bottom"), 0.0)
     out["peak_sigma_zz_5mm"] = _signed_peak(sol, ("sigma_zz_top", "sigma_zz_bottom"), PEAK_WINDOW)
     out["peak_tau_core"] = _signed_peak(sol, ("tau_core",), 0.0)
