@@ -141,6 +141,15 @@ def profile_columns(
         out[f"p_contact_{interface}"] = np.interp(x, model.mesh.x, p_nodes)
         out[f"gap_{interface}"] = np.interp(x, model.mesh.x, g_nodes)
         out[f"sliding_{interface}"] = np.interp(x, model.mesh.x, s_nodes)
+        cohesive = [p for p in model.pairs if p.interface == interface and p.cohesive is not None]
+        if cohesive:  # a growing interface: its committed damage (1: debonded)
+            d_nodes = np.zeros(model.mesh.n_nodes)
+            for p in model.pairs:
+                if p.interface == interface and p.cohesive is None:
+                    d_nodes[p.nodes] = 1.0  # the debond itself
+            for p in cohesive:
+                d_nodes[p.nodes] = p.cohesive.damage.max(axis=1)
+            out[f"damage_{interface}"] = np.interp(x, model.mesh.x, d_nodes)
     return out
 
 

@@ -73,6 +73,12 @@ def test_solve_prints_the_growth_and_writes_the_tips(tmp_path: Path, capsys):
     tips = [float(r["tip_0_end"]) for r in rows]
     assert tips[0] == 40.0 and tips[-1] > 45.0
     assert all("process_zone_0_end" in r for r in rows)
+    with open(out / "profiles.csv") as fh:
+        profile = list(csv.DictReader(fh))
+    last = [r for r in profile if r["step"] == profile[-1]["step"]]
+    damage = {float(r["x"]): float(r["damage_top"]) for r in last}
+    assert damage[min(damage)] == 1.0 and damage[max(damage)] == 0.0  # debond, bonded end
+    assert max(v for x, v in damage.items() if 40.0 < x < tips[-1]) == 1.0  # the grown part
     summary = json.loads((out / "summary.json").read_text())
     growth = summary["debond_growth"]
     assert growth["method"] == "cohesive law"
