@@ -98,3 +98,35 @@ def test_compare_draws_the_cohesive_path_as_a_growth_envelope(tmp_path: Path):
     with open(tmp_path / "growth.csv") as fh:
         (row,) = list(csv.DictReader(fh))
     assert row["method"] == "cohesive law" and float(row["residual_strength_N"]) > 0
+
+
+def test_an_interrupted_growing_run_keeps_its_steps_and_tip_positions(tmp_path: Path):
+    import pytest
+
+    from sandwich.beam import solve
+    from sandwich.models import run_model
+    from sandwich.scene_file import load_scene
+
+    path = tmp_path / "peel.toml"
+    path.write_text(SCENE)
+    scene = load_scene(path)
+
+    def interrupted_once_grown(scene, progress=None):
+        def on_state(item):
+            if progress is not None:
+                progress(item)
+            if getattr(item, "extra", {}).get("tip_0_end", 40.0) > 45.0:
+                raise KeyboardInterrupt  # a Ctrl-C once the tip has run 5 mm
+        return solve(scene, progress=on_state)
+
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        run_model(scene, "beam", out, solver=interrupted_once_grown)
+    with open(out / "history.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert float(rows[-1]["tip_0_end"]) > 45.0 and float(rows[0]["tip_0_end"]) == 40.0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is False and "interrupted" in summary["message"]
+    growth = summary["debond_growth"]
+    assert growth["method"] == "cohesive law"
+    assert growth["tips"]["0_end"]["to"] == float(rows[-1]["tip_0_end"])
