@@ -120,7 +120,7 @@ class Growth:
     tip, over ``zone`` mm (``None``: to the beam end or the next debond on the interface),
     carries a bilinear mixed-mode cohesive law of strengths ``sigma_c`` and ``tau_c`` (MPa) and
     the debond's toughness, with the penalty ``stiffness`` (N/mm³; ``None``: the default of
-    :func:`sandwich.beam.cohesive_law.default_stiffness`). The tips move along the one path.
+    :func:`sandwich.cohesive_law.default_stiffness`). The tips move along the one path.
     """
 
     step: float = 2.0

@@ -2,7 +2,7 @@
 
 Where a scene's debond has ``growth = { method = "cohesive", … }``, the nodes from each tip
 over its span (:meth:`sandwich.scene.Scene.cohesive_spans`) are untied and each carries the law
-of :mod:`sandwich.beam.cohesive_law` between the face's inner surface and the core boundary of
+of :mod:`sandwich.cohesive_law` between the face's inner surface and the core boundary of
 the same x (the same-x pairs of the contact, :mod:`sandwich.beam.contact_gap`): the opening g
 along the core's deformed normal and the sliding s along its tangent. The tie of a bonded node
 also holds the slopes (w_face,x = w_core,x, section 2.3); their jump θ = w_face,x − w_core,x
@@ -39,11 +39,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sandwich.beam.cohesive_law import CohesiveLaw, default_stiffness
 from sandwich.beam.contact_gap import PairKinematics, same_x_kinematics, same_x_sliding
 from sandwich.beam.contact_law import pressure_law
 from sandwich.beam.contact_search import contact_pairs
 from sandwich.beam.dofs import global_dof
+from sandwich.cohesive_law import CohesiveLaw, default_stiffness
 
 #: the pair's seven DOFs: the same-x contact pair's six (PAIR_ROLES), then the face's slope
 SLOPE, CORE_SLOPE = 6, 5

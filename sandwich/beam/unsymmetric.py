@@ -1,7 +1,7 @@
 """Tangents that are not symmetric: a damaging cohesive interface under a changing mode mix.
 
 The Benzeggagh–Kenane law's consistent tangent is not symmetric where the damage grows under a
-changing mode mix (:mod:`sandwich.beam.cohesive_law`). Newton needs the whole matrix to keep
+changing mode mix (:mod:`sandwich.cohesive_law`). Newton needs the whole matrix to keep
 its quadratic convergence (with the symmetric part alone it converges linearly there, and the
 path follower gives up at the load maximum of fig. 5 and c3 given a mixed-mode interface); the
 path follower needs an inertia, which a non-symmetric matrix does not have. So the solves are

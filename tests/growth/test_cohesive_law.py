@@ -1,4 +1,4 @@
-"""The cohesive law (sandwich.beam.cohesive_law) and its pairs in the beam model.
+"""The cohesive law (sandwich.cohesive_law) and its pairs in the beam model.
 
 References: the work of separation under a constant mode mix is the Benzeggagh–Kenane
 toughness in closed form (integrated here by the trapezoid rule along a monotonic opening,
@@ -15,7 +15,7 @@ import pytest
 from benchmarks.cases.fracture_cases import scene
 from sandwich.beam import build_model
 from sandwich.beam.cohesive import pair_damage
-from sandwich.beam.cohesive_law import CohesiveLaw
+from sandwich.cohesive_law import CohesiveLaw
 from sandwich.scene import Growth, Toughness
 
 LAW = CohesiveLaw(2e3, sigma_c=0.5, tau_c=0.8, GIc=1e-3, GIIc=3e-3, eta=2.0)

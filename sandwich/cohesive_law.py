@@ -1,5 +1,8 @@
 """The cohesive law of a growing interface: bilinear, mixed-mode, Benzeggagh–Kenane, irreversible.
 
+Model-independent (the contract): the beam applies it on its interface pairs
+(:mod:`sandwich.beam.cohesive`).
+
 Tractions on the interface per unit area (MPa) of the opening g (along the core's deformed
 normal, > 0 opens) and the sliding s (mm), with a scalar damage D ∈ [0, 1] that never decreases:
 
