@@ -42,7 +42,7 @@ from sandwich.beam.local_responses import (
     reference_tangent_blocks,
 )
 from sandwich.beam.mesh import BeamMesh
-from sandwich.beam.unsymmetric import UnsymmetricFactorization, skew_split
+from sandwich.beam.unsymmetric import SKEW_RTOL, UnsymmetricFactorization, skew_split
 
 PENETRATION_BOUND = 1e-3  # allowed penetration / face thickness
 
@@ -222,11 +222,39 @@ class BeamModel:
         """
         if any(p.cohesive is not None for p in self.pairs):
             K = K if sp.isspmatrix_csr(K) else sp.csr_matrix(K)
-            sym = skew_split(K)
+            sym = self._symmetric_part(K)
             if sym is not None:
                 return UnsymmetricFactorization(K, self.factorisations.factorize(sym,
                                                                                  self.pattern))
         return self.factorisations.factorize(K, self.pattern)
+
+    def _symmetric_part(self, K: sp.csr_matrix) -> sp.csr_matrix | None:
+        """The symmetric part of ``K``, or None where it is symmetric.
+
+        For the compiled path's last tangent, from the cohesive groups' blocks added into it
+        (only they can be unsymmetric): their skew halves taken out of a copy of its values,
+        without transposing the matrix. Any other matrix: :func:`skew_split`.
+        """
+        last = self.last_evaluation
+        kept = last.assembled if last is not None else None
+        kernels = compiled_kernels() if self.use_kernels else None
+        pattern = self.pattern
+        if (kept is None or kept.K is not K or kernels is None
+                or K.indices.size != pattern.indices.size):
+            return skew_split(K)
+        first = len(self.block_dofs) - len(self.pairs)  # the contact groups' first family
+        skews = []
+        for term in kept.terms:
+            if term.compact is None and self.pairs[term.group - first].cohesive is not None:
+                skew = 0.5 * (term.values - np.swapaxes(term.values, 1, 2))
+                if np.max(np.abs(skew), initial=0.0) > SKEW_RTOL * np.max(np.abs(term.values)):
+                    skews.append((term.group, skew))
+        if not skews:
+            return None
+        data = K.data.copy()
+        for group, skew in skews:
+            kernels.scatter_blocks(np.ascontiguousarray(-skew), *pattern.slots_of(group), data)
+        return sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
 
     def probe_vector(self, name: str) -> np.ndarray:
         """C on the free DOFs with probe value c · u (mm)."""

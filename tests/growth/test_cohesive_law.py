@@ -134,3 +134,21 @@ def test_unsymmetric_tangent_is_solved_whole_with_its_symmetric_part_s_inertia()
     assert np.allclose(dense @ fac.solve(b), b, rtol=0, atol=1e-8 * np.abs(b).max())
     eig = np.linalg.eigvalsh(0.5 * (dense + dense.T))
     assert fac.negative_pivots == int(np.sum(eig < 0))
+
+
+def test_symmetric_part_from_the_blocks_equals_the_matrix_s():
+    from sandwich.beam.unsymmetric import skew_split
+
+    sc = scene([("top", 0.0, 1.0)], a=40.0, until=0.5, core=1, elements=40)
+    d = dataclasses.replace(sc.debonds[0], toughness=Toughness(1e-3, 3e-3),
+                            growth=Growth(method="cohesive", sigma_c=0.5, zone=30.0,
+                                          stiffness=2e3))
+    model = build_model(dataclasses.replace(sc, debonds=(d,)))
+    pairs = next(p for p in model.pairs if p.cohesive is not None)
+    u = 6e-4 * np.random.default_rng(4).standard_normal(model.size)
+    pairs.cohesive.damage[:] = 0.5 * pair_damage(pairs, model.expand(u))
+    model.forget_evaluations()
+    K = model.tangent(u)
+    fast, slow = model._symmetric_part(K), skew_split(K)
+    assert fast is not None and slow is not None
+    assert np.abs((fast - slow).toarray()).max() < 1e-9 * np.abs(K.data).max()
