@@ -70,7 +70,7 @@ class CohesiveLaw:
 
     def least_stiffness(self) -> float:
         """The stiffness below which a pure mode's final jump falls below its onset (N/mm³)."""
-        return max(self.sigma_c**2 / (2 * self.GIc), self.tau_c**2 / (2 * self.GIIc))
+        return least_stiffness(self.sigma_c, self.tau_c, self.GIc, self.GIIc)
 
     def toughness(self, mix: np.ndarray | float) -> np.ndarray:
         """Benzeggagh–Kenane G_c at the mode mix B = G_II / G (N/mm)."""
@@ -128,6 +128,16 @@ class CohesiveLaw:
         dD = np.stack([self.damage(gc, s.astype(complex), committed).imag,
                        self.damage(g.astype(complex), sc, committed).imag], axis=-1) / STEP
         return t, T, self.damage(g, s, committed).real, dD
+
+
+def least_stiffness(sigma_c: float, tau_c: float, GIc: float, GIIc: float) -> float:
+    """max(σ_c²/(2 G_Ic), τ_c²/(2 G_IIc)) (N/mm³): a stiffer law reaches its strengths."""
+    return max(sigma_c**2 / (2 * GIc), tau_c**2 / (2 * GIIc))
+
+
+def default_shear_strength(sigma_c: float, GIc: float, GIIc: float) -> float:
+    """τ_c = σ_c √(G_IIc/G_Ic) (MPa): both pure modes then soften over the same jump ratio."""
+    return sigma_c * (GIIc / GIc) ** 0.5
 
 
 STIFFNESS_FACTOR = 1e3  # default K = STIFFNESS_FACTOR · Q_z / h_c

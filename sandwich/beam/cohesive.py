@@ -43,7 +43,12 @@ from sandwich.beam.contact_gap import PairKinematics, same_x_kinematics, same_x_
 from sandwich.beam.contact_law import pressure_law
 from sandwich.beam.contact_search import contact_pairs
 from sandwich.beam.dofs import global_dof
-from sandwich.cohesive_law import CohesiveLaw, default_stiffness
+from sandwich.cohesive_law import (
+    CohesiveLaw,
+    default_shear_strength,
+    default_stiffness,
+    least_stiffness,
+)
 
 #: the pair's seven DOFs: the same-x contact pair's six (PAIR_ROLES), then the face's slope
 SLOPE, CORE_SLOPE = 6, 5
@@ -224,8 +229,9 @@ def cohesive_groups(scene: object, x: np.ndarray, core_modulus: float) -> list:
         nb = nodes[tip] + span.direction
         area[tip] = 0.5 * scene.width * (abs(x[nb] - x[nodes[tip]]) if 0 <= nb < x.size
                                          else 0.0)
-        tau = g.tau_c if g.tau_c is not None else g.sigma_c * (t.GIIc / t.GIc) ** 0.5
-        floor = max(g.sigma_c**2 / (2 * t.GIc), tau**2 / (2 * t.GIIc))
+        tau = g.tau_c if g.tau_c is not None else default_shear_strength(g.sigma_c, t.GIc,
+                                                                         t.GIIc)
+        floor = least_stiffness(g.sigma_c, tau, t.GIc, t.GIIc)
         stiffness = g.stiffness or default_stiffness(core_modulus, scene.core.thickness, floor)
         law = CohesiveLaw(stiffness, g.sigma_c, tau, t.GIc, t.GIIc, t.eta)
         zone = CohesiveZone(law, span.debond, span.tip, span.origin, span.direction,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from sandwich.cohesive_law import default_shear_strength, least_stiffness
 from sandwich.scene import (
     FACES,
     GROWTH_METHODS,
@@ -142,10 +143,10 @@ def _cohesive_growth(r: Reader, gt: dict[str, Any], key: str,
     if sigma is None or tough is None:
         return None
     if tau is None and "tau_c" not in gt:
-        tau = sigma * (tough.GIIc / tough.GIc) ** 0.5
+        tau = default_shear_strength(sigma, tough.GIc, tough.GIIc)
     if tau is None:
         return None
-    floor = max(sigma**2 / (2 * tough.GIc), tau**2 / (2 * tough.GIIc))
+    floor = least_stiffness(sigma, tau, tough.GIc, tough.GIIc)
     if stiffness is not None and stiffness <= floor:
         r.fail(f"{key}.stiffness", f"{stiffness:g} N/mm³ is below {floor:.4g} "
                "(σ_c²/(2 G_Ic), τ_c²/(2 G_IIc)): the law would soften before its strength")

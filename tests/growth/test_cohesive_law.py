@@ -75,14 +75,12 @@ def test_a_stiffness_below_the_strengths_floor_is_refused():
         CohesiveLaw(100.0, sigma_c=1.0, tau_c=1.0, GIc=1e-3, GIIc=1e-3)
 
 
-@pytest.mark.parametrize("toughness", [(1e-3, 1e-3), (1e-3, 3e-3)], ids=["one-mode", "bk"])
-def test_model_tangent_against_finite_differences_with_damage_growing(toughness):
-    """The beam's reduced tangent against central differences of its force, damage growing.
+def damaging_model(toughness=(1e-3, 3e-3), elements=40, seed=2):
+    """A cantilever with a cohesive zone, a state u where most of it damages, and its pairs.
 
-    With equal toughness and strengths the law is mode-independent; under Benzeggagh–Kenane
-    its tangent is not symmetric, and the model's is the whole Jacobian all the same.
+    The committed damage is half of what u gives, so the damage grows at u.
     """
-    sc = scene([("top", 0.0, 1.0)], a=40.0, until=0.5, core=1, elements=60)
+    sc = scene([("top", 0.0, 1.0)], a=40.0, until=0.5, core=1, elements=elements)
     gic, giic = toughness
     d = dataclasses.replace(sc.debonds[0], toughness=Toughness(gic, giic),
                             growth=Growth(method="cohesive", sigma_c=0.5,
@@ -90,12 +88,23 @@ def test_model_tangent_against_finite_differences_with_damage_growing(toughness)
                                           stiffness=2e3))
     model = build_model(dataclasses.replace(sc, debonds=(d,)))
     pairs = next(p for p in model.pairs if p.cohesive is not None)
-    rng = np.random.default_rng(0)
-    u = 6e-4 * rng.standard_normal(model.size)
-    damage = pair_damage(pairs, model.expand(u)).real
+    u = 6e-4 * np.random.default_rng(seed).standard_normal(model.size)
+    damage = pair_damage(pairs, model.expand(u))
     assert np.count_nonzero(damage.max(axis=1)) > pairs.size // 2  # most pairs damaging at u
-    pairs.cohesive.damage[:] = 0.5 * damage  # committed below: the damage grows at u
+    pairs.cohesive.damage[:] = 0.5 * damage
     model.forget_evaluations()
+    return model, pairs, u
+
+
+@pytest.mark.parametrize("toughness", [(1e-3, 1e-3), (1e-3, 3e-3)], ids=["one-mode", "bk"])
+def test_model_tangent_against_finite_differences_with_damage_growing(toughness):
+    """The beam's reduced tangent against central differences of its force, damage growing.
+
+    With equal toughness and strengths the law is mode-independent; under Benzeggagh–Kenane
+    its tangent is not symmetric, and the model's is the whole Jacobian all the same.
+    """
+    model, pairs, u = damaging_model(toughness, elements=60, seed=0)
+    gic, giic = toughness
     K = model.tangent(u).toarray()
     cols = np.unique(model.dof_map.free[pairs.dofs.ravel()])
     cols = cols[cols >= 0]
@@ -117,15 +126,7 @@ def test_model_tangent_against_finite_differences_with_damage_growing(toughness)
 def test_unsymmetric_tangent_is_solved_whole_with_its_symmetric_part_s_inertia():
     from sandwich.beam.unsymmetric import UnsymmetricFactorization
 
-    sc = scene([("top", 0.0, 1.0)], a=40.0, until=0.5, core=1, elements=40)
-    d = dataclasses.replace(sc.debonds[0], toughness=Toughness(1e-3, 3e-3),
-                            growth=Growth(method="cohesive", sigma_c=0.5, zone=30.0,
-                                          stiffness=2e3))
-    model = build_model(dataclasses.replace(sc, debonds=(d,)))
-    pairs = next(p for p in model.pairs if p.cohesive is not None)
-    u = 6e-4 * np.random.default_rng(2).standard_normal(model.size)
-    pairs.cohesive.damage[:] = 0.5 * pair_damage(pairs, model.expand(u))
-    model.forget_evaluations()
+    model, _, u = damaging_model(seed=2)
     K = model.tangent(u)
     fac = model.factorize(K)
     assert isinstance(fac, UnsymmetricFactorization)
@@ -139,15 +140,7 @@ def test_unsymmetric_tangent_is_solved_whole_with_its_symmetric_part_s_inertia()
 def test_symmetric_part_from_the_blocks_equals_the_matrix_s():
     from sandwich.beam.unsymmetric import skew_split
 
-    sc = scene([("top", 0.0, 1.0)], a=40.0, until=0.5, core=1, elements=40)
-    d = dataclasses.replace(sc.debonds[0], toughness=Toughness(1e-3, 3e-3),
-                            growth=Growth(method="cohesive", sigma_c=0.5, zone=30.0,
-                                          stiffness=2e3))
-    model = build_model(dataclasses.replace(sc, debonds=(d,)))
-    pairs = next(p for p in model.pairs if p.cohesive is not None)
-    u = 6e-4 * np.random.default_rng(4).standard_normal(model.size)
-    pairs.cohesive.damage[:] = 0.5 * pair_damage(pairs, model.expand(u))
-    model.forget_evaluations()
+    model, _, u = damaging_model(seed=4)
     K = model.tangent(u)
     fast, slow = model._symmetric_part(K), skew_split(K)
     assert fast is not None and slow is not None
