@@ -54,8 +54,6 @@ from sandwich.cohesive_law import (
 SLOPE, CORE_SLOPE = 6, 5
 #: a pair whose damage is at least this is fully debonded (the law's D reaches 1 exactly)
 DEBONDED = 1.0 - 1e-9
-#: elements a process zone should span for the growth load not to depend on the mesh
-PROCESS_ZONE_ELEMENTS = 3
 #: prefixes of the history columns of :func:`growth_columns`
 GROWTH_COLUMNS = ("tip_", "process_zone_")
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from sandwich.beam.build import scene_gauss_orders
-from sandwich.beam.cohesive import GROWTH_COLUMNS, PROCESS_ZONE_ELEMENTS
+from sandwich.beam.cohesive import GROWTH_COLUMNS
 from sandwich.beam.contact_summary import CONTACT_COLUMNS, contact_columns
 from sandwich.beam.fields import profile_columns, section_fields
 from sandwich.beam.fracture import beam_tips, column_names, release_columns
@@ -107,20 +107,14 @@ def growth_summary(scene: object, solution: Solution, model: BeamModel) -> dict[
     """
     from sandwich.fracture import growth_onset
     from sandwich.growth import cohesive_growing, cohesive_summary
+    from sandwich.growth.cohesive import process_zone_warnings
 
     if cohesive_growing(scene):
         spans = [p for p in model.pairs if p.cohesive is not None]
         size = max((float(np.max(np.diff(model.mesh.x[p.nodes]), initial=0.0)) for p in spans),
                    default=0.0)
         out, warnings = cohesive_summary(scene, solution.history, size)
-        for key, tip in out.get("tips", {}).items():
-            zone = tip["longest_process_zone_mm"]
-            if tip["grew_mm"] > 0 and size > 0 and zone < PROCESS_ZONE_ELEMENTS * size:
-                warnings.append(
-                    f"tip {key}: its process zone ({zone:.3g} mm) spans fewer than "
-                    f"{PROCESS_ZONE_ELEMENTS} elements of {size:.3g} mm: the growth load "
-                    "depends on the mesh (more [beam_model] elements or a lower sigma_c / "
-                    "tau_c resolve it)")
+        warnings += process_zone_warnings(out, size, "more [beam_model] elements")
         solution.warnings.extend(warnings)
         return {"debond_growth": out}
     onset = growth_onset(scene, solution.history)

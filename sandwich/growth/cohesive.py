@@ -17,6 +17,8 @@ from sandwich.scene import Growth, Scene
 METHOD = "cohesive law"
 CRACK_LENGTH_STEP = 2.0  # mm: the step of a cohesive debond grown by crack-length control
 MOVED = 1e-9  # mm: a tip that moved less than this has not grown
+#: elements a process zone should span for the growth load not to depend on the mesh
+PROCESS_ZONE_ELEMENTS = 3
 
 
 def cohesive_tips(scene: Scene) -> list[tuple[int, str, float, float]]:
@@ -84,6 +86,23 @@ def cohesive_summary(scene: Scene, rows: list[StepRecord], element: float | None
         "tips": per_tip,
     }
     return out, warnings
+
+
+def process_zone_warnings(entry: dict[str, object], element: float, more: str) -> list[str]:
+    """Warnings of the tips whose process zone is too short for the mesh.
+
+    A tip whose longest process zone spans fewer than ``PROCESS_ZONE_ELEMENTS`` elements of
+    ``element`` mm: the growth load then depends on the mesh. ``entry`` is
+    :func:`cohesive_summary`'s; ``more`` says how to get more elements (the model's option).
+    """
+    out = []
+    for key, tip in entry.get("tips", {}).items():
+        zone = tip["longest_process_zone_mm"]
+        if tip["grew_mm"] > 0 and element > 0 and zone < PROCESS_ZONE_ELEMENTS * element:
+            out.append(f"tip {key}: its process zone ({zone:.3g} mm) spans fewer than "
+                       f"{PROCESS_ZONE_ELEMENTS} elements of {element:.3g} mm: the growth load "
+                       f"depends on the mesh ({more} or a lower sigma_c / tau_c resolve it)")
+    return out
 
 
 def cohesive_growing(scene: Scene) -> bool:

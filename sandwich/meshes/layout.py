@@ -22,9 +22,28 @@ PRIORITY = {"end": 0, "symmetry": 0, "debond": 1, "support": 2, "load": 3, "prob
 SHARP = ("debond", "support", "load")  # kinds whose station gets the tip element size
 
 
+def crack_extent(scene: Scene, index: int) -> tuple[float, float]:
+    """The stretch of interface debond ``index`` has lips over (mm).
+
+    The debond, and for a debond grown by a cohesive law its spans too
+    (:meth:`sandwich.scene.Scene.cohesive_spans`), whose face and core sides the law holds together
+    until it lets them go.
+    """
+    d = scene.debonds[index]
+    lo, hi = d.start, d.end
+    for span in scene.cohesive_spans():
+        if span.debond == index:
+            lo, hi = min(lo, span.far), max(hi, span.far)
+    return lo, hi
+
+
 @dataclass(frozen=True)
 class Crack:
-    """A debond as meshed: scene index, interface and its (possibly snapped) ends (mm)."""
+    """A debond as meshed: scene index, interface and its (possibly snapped) lips' ends (mm).
+
+    A debond grown by a cohesive law has lips over its spans too (:func:`crack_extent`): its
+    ends are then the spans' far ends, where the lips meet in a bonded corner (or an open mouth).
+    """
 
     index: int
     interface: str  # "top" | "bottom"
@@ -101,6 +120,9 @@ def _entries(scene: Scene, x_end: float, half: bool) -> list[tuple[float, str, s
         if d.length > 0:
             out += [(d.start, "debond", f"debonds[{i}].start"),
                     (d.end, "debond", f"debonds[{i}].end")]
+            lo, hi = crack_extent(scene, i)
+            out += [(x, "debond", f"debonds[{i}].growth.zone ({which})")
+                    for x, which, at in ((lo, "start", d.start), (hi, "end", d.end)) if x != at]
     for i, s in enumerate(scene.supports):
         out.append((s.x, "support", f"supports[{i}].x"))
     for i, ld in enumerate(scene.loads):
@@ -197,7 +219,9 @@ def _layout(scene: Scene, snap_tolerance: float, half: bool) -> Layout:
     for i, d in enumerate(scene.debonds):
         if d.length <= 0:
             continue  # zero length: bonded
-        a, b = where.get(f"debonds[{i}].start", d.start), where.get(f"debonds[{i}].end", d.end)
+        lo, hi = crack_extent(scene, i)
+        a = where.get(f"debonds[{i}].growth.zone (start)", where.get(f"debonds[{i}].start", lo))
+        b = where.get(f"debonds[{i}].growth.zone (end)", where.get(f"debonds[{i}].end", hi))
         if half and a >= x_end - GEOM_TOL:
             continue
         cracks.append(Crack(i, d.interface, a, b))

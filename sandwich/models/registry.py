@@ -54,9 +54,6 @@ class ModelSpec:
     packages
         Packages and modules (paths under the project root) whose sources the result depends on
         (their digest is part of the identity).
-    cohesive
-        Whether the model grows a debond by a cohesive law; one without it grows a cohesive
-        debond by crack-length control (:func:`sandwich.growth.as_crack_length`).
     """
 
     name: str
@@ -64,7 +61,6 @@ class ModelSpec:
     options_table: str
     resolution_keys: tuple[str, ...]
     packages: tuple[str, ...]
-    cohesive: bool = False
 
     def options(self, scene: Scene) -> dict[str, object]:
         """The model's options table of ``scene`` as a plain dict."""
@@ -86,13 +82,14 @@ class ModelSpec:
 
 # The contract every model is built on: paths under the project root, for the code digest.
 CONTRACT = ("sandwich/__init__.py", "sandwich/scene.py", "sandwich/scene_checks",
+            "sandwich/cohesive_law.py",
             "sandwich/scene_file.py", "sandwich/fracture.py", "sandwich/results", "sandwich/solver")
 
 MODELS: dict[str, ModelSpec] = {
     "beam": ModelSpec("beam", _solve_beam, "beam_model",
                       ("elements", "grading", "core", "core_basis", "max_core_level",
                        "core_zones", "tolerance", "face_membrane", "faces", "contact_search"),
-                      ("sandwich/beam", *CONTRACT), cohesive=True),
+                      ("sandwich/beam", *CONTRACT)),
     "2d": ModelSpec("2d", _solve_2d, "reference2d",
                     ("level", "refine", "face_elements", "core_size", "face_size", "tip_size",
                      "half_model"),

@@ -22,7 +22,6 @@ from pathlib import Path
 
 from sandwich.fracture import growth_onset, ill_conditioned_releases, missing_releases
 from sandwich.growth import (
-    as_crack_length,
     cohesive_growing,
     cohesive_summary,
     final_scene,
@@ -31,7 +30,6 @@ from sandwich.growth import (
     growth_summary,
     onset_rows,
 )
-from sandwich.growth.cohesive import CRACK_LENGTH_STEP
 from sandwich.models.registry import get_model
 from sandwich.results import (
     InterruptedSolve,
@@ -167,11 +165,6 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
     check_output_folder(folder)
     identity = spec.identity(scene, root)
     model_solve = solver or spec.solve
-    stand_in = ""
-    if cohesive_growing(scene) and not spec.cohesive:  # the same debond, grown by its G
-        scene = as_crack_length(scene)
-        stand_in = (f"the {model} model has no cohesive law: the cohesive debond is grown by "
-                    f"crack-length control with its toughness ({CRACK_LENGTH_STEP:g} mm steps)")
     if growing(scene):  # debonds grown by crack-length control: a path per length
 
         def solve(scene: Scene, progress=None) -> Solution:
@@ -211,8 +204,6 @@ def run_model(scene: Scene, model: str, folder: Path, *, progress: Progress | No
             _write(partial, folder, scene)
         say(ProgressEvent(model, "interrupted", step=len(streamed), message=partial.message))
         raise
-    if stand_in:
-        solution.warnings.insert(0, stand_in)
     near = ill_conditioned_releases(solution.history, solution.limit_points)
     if near:  # either model: G close below a critical load
         solution.warnings.append(near)

@@ -53,11 +53,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 J = np.array([[0.0, -1.0], [1.0, 0.0]])  # rotation by +90°
-# X = (x_s, x_0, x_1, x_2) stacked (8,); d = x_s − x_0 and a = x_2 − x_1 as linear maps of X
+# X = (x_s, x_0, x_1, x_2) stacked (8,); d = x_s − x_0 (JUMP_MAP) and a = x_2 − x_1 (CHORD_MAP)
+# as linear maps of X
 _Z = np.zeros((2, 2))
 _I = np.eye(2)
-_D = np.hstack([_I, -_I, _Z, _Z])
-_A = np.hstack([_Z, _Z, -_I, _I])
+JUMP_MAP = np.hstack([_I, -_I, _Z, _Z])
+CHORD_MAP = np.hstack([_Z, _Z, -_I, _I])
 
 #: Master chain nodes on either side of a slave's coincident node that the matrix pattern holds
 #: from the start (a chain node every half element: four quadratic edges each way).
@@ -86,8 +87,9 @@ def gap_with_derivatives(xs, x0, x1, x2):
     H_da = J / L - np.outer(n, a) / L2  # ∂n/∂a = ∂²g/∂d∂a
     H_aa = (np.outer(J @ d, a) / (L2 * L) - np.outer(a, g_a) / L2 - g * np.eye(2) / L2
             + 2.0 * g * np.outer(a, a) / (L2 * L2))
-    grad = _D.T @ g_d + _A.T @ g_a
-    hess = _D.T @ H_da @ _A + _A.T @ H_da.T @ _D + _A.T @ H_aa @ _A
+    grad = JUMP_MAP.T @ g_d + CHORD_MAP.T @ g_a
+    hess = (JUMP_MAP.T @ H_da @ CHORD_MAP + CHORD_MAP.T @ H_da.T @ JUMP_MAP
+            + CHORD_MAP.T @ H_aa @ CHORD_MAP)
     return g, grad, 0.5 * (hess + hess.T)
 
 
@@ -111,8 +113,9 @@ def gaps_with_derivatives(d: np.ndarray, a: np.ndarray):
             - (g / L2)[:, None, None] * np.eye(2)[None]
             + (2.0 * g / (L2 * L2))[:, None, None] * np.einsum("ni,nj->nij", a, a))
     grad = np.concatenate([n, -n, -g_a, g_a], axis=1)
-    cross = np.einsum("ia,nij,jb->nab", _D, H_da, _A)
-    hess = cross + cross.transpose(0, 2, 1) + np.einsum("ia,nij,jb->nab", _A, H_aa, _A)
+    cross = np.einsum("ia,nij,jb->nab", JUMP_MAP, H_da, CHORD_MAP)
+    hess = cross + cross.transpose(0, 2, 1) + np.einsum("ia,nij,jb->nab", CHORD_MAP, H_aa,
+                                                        CHORD_MAP)
     return g, grad, 0.5 * (hess + hess.transpose(0, 2, 1))
 
 
@@ -199,6 +202,9 @@ class ContactPair:
     x_ref: np.ndarray  # (ns,) reference x of the slave nodes (for profiles)
     window: np.ndarray | None = None  # (ns, 2) chain positions [lo, hi] the matrix holds
     widen_depth: float = np.inf  # deeper slaves never widen their windows (mm)
+    # the slaves a cohesive law holds, one entry per growing tip
+    # (:class:`sandwich.plane2d.cohesive.CohesiveLips`, indices into ``slave``)
+    cohesive: tuple = ()
 
     def __post_init__(self):
         """The initial windows: :data:`WINDOW` chain nodes either side of the anchor."""
@@ -240,7 +246,8 @@ class ContactPair:
         def m(a):
             return np.vectorize(lambda k: index[int(k)], otypes=[np.int64])(a)
         return ContactPair(m(self.slave), m(self.master), self.anchor, self.weight,
-                           self.penalty, self.width, self.x_ref, self.window, self.widen_depth)
+                           self.penalty, self.width, self.x_ref, self.window, self.widen_depth,
+                           self.cohesive)
 
 
 @dataclass

@@ -69,7 +69,12 @@ def default_closure_length(scene) -> float:
 
 
 def tip_geometries(model: Model2D, closure_length: float) -> list[TipGeometry]:
-    """Every debond tip present in the mesh (open mouths at beam ends have none)."""
+    """Every debond tip present in the mesh (open mouths at beam ends have none).
+
+    Not the tips of a debond grown by a cohesive law: its lips run on over its spans, where
+    the law holds them (no crack closure there); the law's tip positions are its columns
+    (:mod:`sandwich.plane2d.cohesive`).
+    """
     mesh, scene = model.mesh, model.scene
     pts = np.asarray(mesh.points)[:, :2]
     named = getattr(mesh, "point_nodes", {}) or {}
@@ -77,6 +82,8 @@ def tip_geometries(model: Model2D, closure_length: float) -> list[TipGeometry]:
     out = []
     for i, debond in enumerate(scene.debonds):
         if i not in lip_pairs or len(lip_pairs[i]) == 0:
+            continue
+        if debond.growth is not None and debond.growth.cohesive:
             continue
         pairs = np.asarray(lip_pairs[i])
         lip = set(map(int, pairs.ravel()))

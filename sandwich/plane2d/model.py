@@ -25,7 +25,9 @@ from dolfinx import fem, geometry
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from sandwich.meshes.layout import crack_extent
 from sandwich.plane2d import contact as ct
+from sandwich.plane2d.cohesive import cohesive_lips
 from sandwich.plane2d.constitutive import LayerBand, PlaneStressStiffness, internal_work
 from sandwich.plane2d.loads import edge_facets, edge_length, edge_load_vector
 from sandwich.plane2d.mesh import Discretisation, build_discretisation
@@ -265,7 +267,7 @@ def contact_pairs(scene: Scene, mesh, disc: Discretisation,
         core_sorted = core_nodes[order]
         lip_set = set(map(int, nodes.ravel()))
         tips = []
-        for x_tip in (debond.start, debond.end):
+        for x_tip in crack_extent(scene, i):  # a cohesive debond's lips run over its spans
             hit = np.where((np.abs(pts[:, 0] - x_tip) < GEOM_TOL)
                            & (np.abs(pts[:, 1] - z) < GEOM_TOL))[0]
             hit = [h for h in hit if int(h) not in lip_set]
@@ -283,7 +285,9 @@ def contact_pairs(scene: Scene, mesh, disc: Discretisation,
         # a missing tip is an open mouth (debond reaching the beam end): no bonded corner there
         x_tips = [None if t is None else float(pts[t, 0]) for t in tips]
         weight = ct.slave_weights(x_face, x_tips[0], x_tips[1])  # start < end (scene checks)
+        lips = tuple(cohesive_lips(scene, x_face, i, scene.core.material.Qz,
+                                   1e-9 * scene.length))
         pairs.append(ct.ContactPair(slave, master, anchor, weight, penalty, scene.width, x_face,
-                                    widen_depth=WIDEN_DEPTH * h_face))
+                                    widen_depth=WIDEN_DEPTH * h_face, cohesive=lips))
         ifaces.append(debond.interface)
     return pairs, ifaces

@@ -5,7 +5,9 @@ element reports them: ``sigma_zz_top``/``sigma_zz_bottom`` is S_zz of the *core*
 boundary (z = ±h_c/2, evaluated in the core cell), ``tau_core`` is S_xz at the core mid-plane,
 ``tau_top``/``tau_bottom`` S_xz of the core at its top/bottom boundary (interface shear).
 Contact on each interface's debonds, from the face-lip nodes: ``p_contact_*`` (MPa), ``gap_*``
-and ``sliding_*`` (mm; :mod:`sandwich.plane2d.contact`), zero where bonded.
+and ``sliding_*`` (mm; :mod:`sandwich.plane2d.contact`), zero where bonded. On an interface with
+a debond grown by a cohesive law, ``damage_*``: the committed damage (1 on the debond,
+:mod:`sandwich.plane2d.cohesive`).
 Stations are the x of the mesh nodes on the top interface.
 """
 
@@ -112,7 +114,27 @@ class ProfileSampler:
                     lips[name][inside] += np.interp(self.x[inside], xs, values[order])
             for name, values in lips.items():
                 cols[f"{name}_{iface}"] = values
+            damage = self._damage(iface)
+            if damage is not None:
+                cols[f"damage_{iface}"] = damage
         return cols
+
+    def _damage(self, iface: str) -> np.ndarray | None:
+        """The committed damage along a growing interface (1 on its debonds), else None."""
+        pairs = [(p, z) for p, where in zip(self.model.contact_pairs,
+                                            self.model.contact_interfaces, strict=True)
+                 if where == iface for z in p.cohesive]
+        if not pairs:
+            return None
+        d = np.zeros(len(self.x))
+        for deb in self.model.scene.debonds_on(iface):  # the debonds themselves
+            d[(self.x >= deb.start - GEOM_TOL) & (self.x <= deb.end + GEOM_TOL)] = 1.0
+        for _pair, z in pairs:
+            order = np.argsort(z.x)
+            xs = z.x[order]
+            inside = (self.x >= xs[0] - GEOM_TOL) & (self.x <= xs[-1] + GEOM_TOL)
+            d[inside] = np.interp(self.x[inside], xs, z.damage[order])
+        return d
 
 
 def _bands(model: Model2D) -> list[str]:

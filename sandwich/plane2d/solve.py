@@ -7,7 +7,9 @@ import time
 import numpy as np
 
 from sandwich.fracture import growth_onset
+from sandwich.growth.cohesive import cohesive_growing, cohesive_summary, process_zone_warnings
 from sandwich.plane2d.beside import Beside, can_run_beside
+from sandwich.plane2d.cohesive import growth_columns, lip_element_length
 from sandwich.plane2d.core_crushing import CoreCrushing, CoreState, crushing_warning
 from sandwich.plane2d.fracture import VcctEvaluator, history_columns
 from sandwich.plane2d.mesh_error import (
@@ -151,6 +153,7 @@ def _solve_path(scene: Scene, progress, level: str, refine: int, mesh, penalty: 
                  "cuts": float(state.cuts)}
         if state.negative_pivots is not None:
             extra["negative_pivots"] = float(state.negative_pivots)
+        extra.update(growth_columns(system.cohesive_lips))  # of the damage just committed
         if tied_lips:  # G columns left empty (G_warning below says why)
             extra.update({n: None for t in vcct.tips for n in column_names(t.debond, t.tip)})
         else:
@@ -212,8 +215,13 @@ def _solve_path(scene: Scene, progress, level: str, refine: int, mesh, penalty: 
         extra["G_warning"] = (f"a support acts within the closure length ahead of tip(s) "
                               f"{', '.join(vcct.supported_tips())}: its reaction enters the "
                               "VCCT force, G there is not reliable")
-    onset = growth_onset(scene, rows)  # debonds with a toughness: first step G >= G_c
-    if onset:
+    if cohesive_growing(scene):  # the tips the path moved
+        size = lip_element_length(system.cohesive_lips)
+        entry, grown = cohesive_summary(scene, rows, size)
+        extra["debond_growth"] = entry
+        warnings += grown + process_zone_warnings(entry, size,
+                                                  "a finer [reference2d] level or refine")
+    elif onset := growth_onset(scene, rows):  # debonds with a toughness: first step G >= G_c
         extra["debond_growth"] = onset
     if core_states:
         extra["core_min_stretch"] = min(c.min_stretch for _, _, c in core_states)

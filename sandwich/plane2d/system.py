@@ -24,11 +24,16 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from sandwich.plane2d import cohesive as cz
 from sandwich.plane2d import contact as ct
 from sandwich.plane2d.mesh import allreduce_array, block_input_coordinates, input_node_blocks
 from sandwich.plane2d.roundoff import ResidualRoundoff
 
 JIT = {"cffi_extra_compile_args": ["-O2"]}
+#: a cohesive skew half below this × the blocks' size is round-off (the tangent is symmetric)
+SKEW_FLOOR = 1e-12
+KRYLOV_RTOL = 1e-10  # GMRES on an unsymmetric tangent: relative residual
+KRYLOV_MAX = 200  # and its iterations
 
 
 class MumpsSolver:
@@ -44,6 +49,8 @@ class MumpsSolver:
         self.comm = comm
         self.ksp = None
         self.analyses = 0  # symbolic analyses done (1 unless a factorisation failed)
+        self._krylov = None  # GMRES on the whole tangent (:meth:`solve_whole`)
+        self.krylov_iterations = 0
 
     def _create(self, K: PETSc.Mat) -> None:
         self.ksp = PETSc.KSP().create(self.comm)
@@ -86,11 +93,46 @@ class MumpsSolver:
         """X = K⁻¹ b with the current factorisation."""
         self.ksp.solve(b, x)
 
+    def solve_whole(self, K: PETSc.Mat, b: PETSc.Vec, x: PETSc.Vec) -> bool:
+        """X = K⁻¹ b for the whole (unsymmetric) tangent ``K`` by preconditioned GMRES.
+
+        Right-preconditioned by the current factorisation of K's symmetric part. The two differ by
+        the cohesive blocks' skew halves, of rank r at most 8 × the damaging nodes, so that GMRES
+        converges within about r + 1 iterations (exactly, in exact arithmetic). Returns whether
+        it converged (to ``KRYLOV_RTOL`` of ``b``, within ``KRYLOV_MAX`` iterations); ``x`` is
+        its last iterate either way.
+        """
+        if self._krylov is None:
+            k = PETSc.KSP().create(self.comm)
+            k.setType("gmres")
+            k.setGMRESRestart(KRYLOV_MAX)
+            k.setPCSide(PETSc.PC.Side.RIGHT)  # the true residual is the one monitored
+            k.setTolerances(rtol=KRYLOV_RTOL, atol=0.0, max_it=KRYLOV_MAX)
+            pc = k.getPC()
+            pc.setType("python")
+            pc.setPythonContext(_Factors(self))
+            self._krylov = k
+        self._krylov.setOperators(K)
+        self._krylov.solve(b, x)
+        self.krylov_iterations += self._krylov.getIterationNumber()
+        return self._krylov.getConvergedReason() > 0
+
     def reset(self) -> None:
         """Drop the KSP (after a failure: the next tangent starts with a fresh analysis)."""
         if self.ksp is not None:
             self.ksp.destroy()
             self.ksp = None
+
+
+class _Factors:
+    """The symmetric part's LDLᵀ as a PETSc python preconditioner (of :meth:`solve_whole`)."""
+
+    def __init__(self, solver: MumpsSolver):
+        self.solver = solver
+
+    def apply(self, pc, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """Y = S⁻¹ x."""
+        self.solver.ksp.solve(x, y)
 
 
 class MumpsFactorization:
@@ -119,7 +161,11 @@ class MumpsFactorization:
             self._neg = s._factor_current()
             self.generation = s._generation
         s._rhs.array[:] = b
-        s._mumps.solve(s._rhs, s._sol)
+        if s.A_full is None:
+            s._mumps.solve(s._rhs, s._sol)
+        elif not s._mumps.solve_whole(s.A_full, s._rhs, s._sol):
+            # GMRES minimises the residual: its last iterate is kept (counted)
+            s.counters["krylov_unconverged"] += 1
         return s._sol.array.copy()
 
     @property
@@ -170,7 +216,11 @@ class Reference2DSystem(ResidualRoundoff):
         self.last_contact: list[ct.ContactState] = []  # of the committed state
         self._evaluated_contact: list[ct.ContactState] = []  # of the last internal_force
         self.counters = {"residuals": 0, "tangents": 0, "factorizations": 0,
-                         "refactorizations": 0, "pattern_growths": 0}
+                         "refactorizations": 0, "pattern_growths": 0, "unsymmetric_tangents": 0,
+                         "krylov_unconverged": 0}
+        self.A_full: PETSc.Mat | None = None  # the whole tangent, where not symmetric
+        # (u, per growing tip its damage) of every committed state (a cohesive law's history)
+        self.damage_history: list[tuple[np.ndarray, list[np.ndarray]]] = []
         self._mumps = MumpsSolver(self.comm)
         self._rhs, self._sol = self.A.createVecs()
         self._generation = 0
@@ -202,6 +252,8 @@ class Reference2DSystem(ResidualRoundoff):
             if states:
                 f = np.zeros((self._nc, 2))
                 for state, _pair in states:
+                    f += state.nodal_forces(self._nc)
+                for state in self._cohesive_states(want_tangent=False):
                     f += state.nodal_forces(self._nc)
                 # owned contact nodes only (ghost entries would be summed twice)
                 b_local.array.reshape(-1, self.bs)[self._c_own_blk] += f[self._c_own]
@@ -235,14 +287,26 @@ class Reference2DSystem(ResidualRoundoff):
         fem_petsc.assemble_matrix(A, self.J_form)
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+        skew = None
         if self._c_nnz:
             # every contact slot of the pattern (zeros where open), summed over the active
-            # slaves' 10×10 blocks with one bincount, inserted row by row (owned rows only)
+            # slaves' 10×10 blocks with one bincount, inserted row by row (owned rows only);
+            # the cohesive blocks' symmetric halves with them, their skew halves apart
             data = np.zeros(self._c_nnz)
             for state, _pair in states:
                 slots, found = self._contact_slots(state.rows)
                 data += np.bincount(slots[found], weights=state.tangents.ravel()[found],
                                     minlength=self._c_nnz)
+            cohesive = self._cohesive_states(want_tangent=True)
+            if cohesive:
+                skew = np.zeros(self._c_nnz)
+            for state in cohesive:
+                slots, found = self._contact_slots(state.rows)
+                K = state.tangents
+                data += np.bincount(slots[found], minlength=self._c_nnz,
+                                    weights=(0.5 * (K + K.transpose(0, 2, 1))).ravel()[found])
+                skew += np.bincount(slots[found], minlength=self._c_nnz,
+                                    weights=(0.5 * (K - K.transpose(0, 2, 1))).ravel()[found])
             add = PETSc.InsertMode.ADD_VALUES
             for row, lo, hi in self._c_rows:
                 A.setValues(row, self._c_cols[lo:hi], data[lo:hi], addv=add)
@@ -250,9 +314,42 @@ class Reference2DSystem(ResidualRoundoff):
         own_bc = self.bc_dofs[self.bc_dofs < self.n_owned]
         glob = (self.V.dofmap.index_map.local_range[0] * self.bs + own_bc).astype(np.int32)
         A.zeroRowsColumns(glob, diag=1.0)
+        self._set_skew(skew, glob)
         self.counters["tangents"] += 1
         self._tangent_u = np.array(u, dtype=float)
         return A
+
+    def _set_skew(self, skew: np.ndarray | None, bc_rows: np.ndarray) -> None:
+        """The whole tangent where the cohesive blocks are not symmetric, else none.
+
+        ``A`` holds the symmetric part (MUMPS's LDLᵀ factorises it, and gives the inertia the
+        path follower reads); ``A_full`` = A + the skew half, which Krylov iterations
+        preconditioned by that LDLᵀ solve with (:class:`MumpsFactorization`). A skew half below
+        ``SKEW_FLOOR`` × the largest entry of the blocks is left out (round-off of symmetric
+        blocks).
+        """
+        if self.A_full is not None:
+            self.A_full.destroy()
+            self.A_full = None
+        size = 0.0 if skew is None or not skew.size else float(np.max(np.abs(skew)))
+        if self.comm.size > 1:
+            size = self.comm.allreduce(size, op=MPI.MAX)
+        if size <= SKEW_FLOOR * self._cohesive_scale():
+            return
+        full = self.A.duplicate(copy=True)
+        add = PETSc.InsertMode.ADD_VALUES
+        for row, lo, hi in self._c_rows:
+            full.setValues(row, self._c_cols[lo:hi], skew[lo:hi], addv=add)
+        full.assemble()
+        full.setOption(PETSc.Mat.Option.SYMMETRIC, False)
+        full.zeroRowsColumns(bc_rows, diag=1.0)
+        self.A_full = full
+        self.counters["unsymmetric_tangents"] += 1
+
+    def _cohesive_scale(self) -> float:
+        """A size of the cohesive blocks: the largest law stiffness × area (N/mm)."""
+        return max((lips.law.stiffness * p.width * float(np.max(lips.weight, initial=0.0))
+                    for p in self.contacts for lips in p.cohesive), default=0.0)
 
     def factorize(self, K: PETSc.Mat) -> MumpsFactorization:
         """LDLᵀ with MUMPS (symmetric indefinite), inertia reported.
@@ -273,9 +370,35 @@ class Reference2DSystem(ResidualRoundoff):
         return self.probes[name][: self.n_owned]
 
     def commit(self, u: np.ndarray, load_factor: float) -> None:
-        """Penalty contact keeps no history: store the contact state of the converged ``u``."""
+        """Store the contact state of the converged ``u`` and commit its cohesive damage.
+
+        The damage committed at every state is kept: a state committed again (the profiles
+        sample the path's states after the run) takes back its own damage.
+        """
         self._set_u(u)
         self.last_contact = [s for s, _ in self._contact_states(want_tangent=False)]
+        lips = self.cohesive_lips
+        if not lips:
+            return
+        for at, damage in reversed(self.damage_history):
+            if at.shape == np.shape(u) and np.array_equal(at, u):
+                for z, d in zip(lips, damage, strict=True):
+                    z.damage[:] = d
+                return
+        for z, state in zip(lips, self._cohesive_states(want_tangent=False), strict=True):
+            z.damage[:] = state.damage
+        self.damage_history.append((np.array(u, dtype=float, copy=True),
+                                    [z.damage.copy() for z in lips]))
+
+    @property
+    def cohesive_lips(self) -> list:
+        """Every growing tip's :class:`~sandwich.plane2d.cohesive.CohesiveLips`, pair by pair."""
+        return [z for p in self.contacts for z in p.cohesive]
+
+    @property
+    def path_dependent(self) -> bool:
+        """Whether the model has history (cohesive damage): its state is not (u, λ) alone."""
+        return bool(self.cohesive_lips)
 
     def admissible(self, u: np.ndarray) -> str:
         """``""`` if det F > 0 at every node of every cell, else where it is not.
@@ -391,17 +514,30 @@ class Reference2DSystem(ResidualRoundoff):
         self._mumps.reset()
         self.counters["pattern_growths"] += 1
 
-    def _contact_states(self, want_tangent: bool):
-        """[(state, pair)] of every pair, from the contact-node displacements of all ranks."""
-        if not self.contacts:
-            return []
+    def _contact_displacements(self) -> np.ndarray:
+        """The displacements (n_c, 2) of the contact nodes, gathered from all ranks."""
         u = self.u.x.array.reshape(-1, self.bs)
         uc = np.zeros((self._nc, 2))
         uc[self._c_own] = u[self._c_own_blk]
         if self.comm.size > 1:
             uc = allreduce_array(self.comm, uc, MPI.SUM)
+        return uc
+
+    def _contact_states(self, want_tangent: bool):
+        """[(state, pair)] of every pair, from the contact-node displacements of all ranks."""
+        if not self.contacts:
+            return []
+        uc = self._contact_displacements()
         return [(ct.evaluate(self._compact[id(p)], self._c_xref, uc, want_tangent), p)
                 for p in self.contacts]
+
+    def _cohesive_states(self, want_tangent: bool) -> list[cz.CohesiveState]:
+        """The cohesive law of every growing tip at the current ``u`` (the committed damage)."""
+        if not self.cohesive_lips:
+            return []
+        uc = self._contact_displacements()
+        return [cz.evaluate(self._compact[id(p)], lips, self._c_xref, uc, want_tangent)
+                for p in self.contacts for lips in p.cohesive]
 
     def _create_matrix(self) -> PETSc.Mat:
         """AIJ matrix (block size 2) with the form's pattern plus every contact coupling.

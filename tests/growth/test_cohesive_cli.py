@@ -4,6 +4,8 @@ import csv
 import json
 from pathlib import Path
 
+import numpy as np
+
 from sandwich.cli import main
 
 SCENE = """
@@ -81,6 +83,32 @@ def test_solve_prints_the_growth_and_writes_the_tips(tmp_path: Path, capsys):
     assert max(v for x, v in damage.items() if 40.0 < x < tips[-1]) == 1.0  # the grown part
     summary = json.loads((out / "summary.json").read_text())
     growth = summary["debond_growth"]
+    assert growth["method"] == "cohesive law"
+    assert growth["residual_strength"] >= growth["first_growth_load"] > 0
+
+
+def test_the_2d_model_grows_the_same_debond_by_the_same_law(tmp_path: Path, capsys):
+    """`sandwich solve --model 2d`: its own cohesive law, the same columns and summary."""
+    import pytest
+
+    pytest.importorskip("dolfinx")
+    path = tmp_path / "peel.toml"
+    path.write_text(SCENE + '\n[reference2d]\nlevel = "coarse"\n')
+    out = tmp_path / "out"
+    assert main(["solve", str(path), "--model", "2d", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "growth (cohesive law): first at load factor" in said
+    assert "no cohesive law" not in said
+    with open(out / "history.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    tips = [float(r["tip_0_end"]) for r in rows]
+    assert tips[0] == 40.0 and tips[-1] > 45.0 and all(np.diff(tips) >= 0)
+    with open(out / "profiles.csv") as fh:
+        profile = list(csv.DictReader(fh))
+    last = [r for r in profile if r["step"] == profile[-1]["step"]]
+    damage = {float(r["x"]): float(r["damage_top"]) for r in last}
+    assert damage[min(damage)] == 1.0 and damage[max(damage)] == 0.0
+    growth = json.loads((out / "summary.json").read_text())["debond_growth"]
     assert growth["method"] == "cohesive law"
     assert growth["residual_strength"] >= growth["first_growth_load"] > 0
 
