@@ -9,13 +9,10 @@ them (any model that writes them).
 
 from __future__ import annotations
 
-import dataclasses
-
 from sandwich.results import StepRecord
-from sandwich.scene import Growth, Scene
+from sandwich.scene import Scene
 
 METHOD = "cohesive law"
-CRACK_LENGTH_STEP = 2.0  # mm: the step of a cohesive debond grown by crack-length control
 MOVED = 1e-9  # mm: a tip that moved less than this has not grown
 #: elements a process zone should span for the growth load not to depend on the mesh
 PROCESS_ZONE_ELEMENTS = 3
@@ -108,20 +105,3 @@ def process_zone_warnings(entry: dict[str, object], element: float, more: str) -
 def cohesive_growing(scene: Scene) -> bool:
     """Whether a debond of ``scene`` grows by a cohesive law."""
     return any(d.growth is not None and d.growth.cohesive for d in scene.debonds)
-
-
-def as_crack_length(scene: Scene, step: float = CRACK_LENGTH_STEP) -> Scene:
-    """``scene`` with its cohesive debonds grown by crack-length control instead.
-
-    For a model without the cohesive law (the 2D reference): the same toughness, tips advanced
-    by ``step`` mm, as far as the cohesive spans reach (:mod:`sandwich.growth.crack_length`).
-    """
-    reach: dict[int, float] = {}
-    for s in scene.cohesive_spans():
-        reach[s.debond] = reach.get(s.debond, 0.0) + abs(s.far - s.origin)
-    debonds = []
-    for i, d in enumerate(scene.debonds):
-        if d.growth is not None and d.growth.cohesive:
-            d = dataclasses.replace(d, growth=Growth(step, d.length + reach.get(i, 0.0)))
-        debonds.append(d)
-    return dataclasses.replace(scene, debonds=tuple(debonds))

@@ -1,11 +1,7 @@
-"""A cohesive path's summary and the 2D model's stand-in, on hand-made scenes and rows."""
-
-import dataclasses
-
-import pytest
+"""A cohesive path's summary, on hand-made scenes and rows."""
 
 from benchmarks.cases.growth_cases import cohesive_cantilever
-from sandwich.growth import as_crack_length, cohesive_growing, cohesive_summary, growing
+from sandwich.growth import cohesive_summary
 from sandwich.results import StepRecord
 
 
@@ -29,14 +25,3 @@ def test_summary_reads_first_growth_residual_strength_and_the_span_end():
     assert len(warnings) == 1 and "x = 60 mm" in warnings[0]  # 55 + 5 reaches the span's end
     out, warnings = cohesive_summary(sc, rows[:3], element=0.5)
     assert out["first_growth_load"] is None and not warnings and out["span_end_step"] is None
-
-
-def test_a_model_without_the_law_grows_the_same_debond_by_crack_length():
-    sc = cohesive_cantilever(zone=30.0)
-    assert cohesive_growing(sc) and not growing(sc)
-    stand_in = as_crack_length(sc)
-    assert growing(stand_in) and not cohesive_growing(stand_in)
-    d = stand_in.debonds[0]
-    assert d.toughness == sc.debonds[0].toughness
-    assert d.growth.max_length == pytest.approx(40.0 + 30.0)
-    assert dataclasses.replace(d, growth=None) == dataclasses.replace(sc.debonds[0], growth=None)
