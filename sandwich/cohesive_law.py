@@ -130,6 +130,17 @@ class CohesiveLaw:
         return t, T, self.damage(g, s, committed).real, dD
 
 
+@dataclass(eq=False)
+class CohesiveTip:
+    """A debond tip grown by the law: the law, which tip, where it started and which way."""
+
+    law: CohesiveLaw
+    debond: int
+    tip: str  # "start" | "end"
+    origin: float  # the tip's x at the start of the run (mm)
+    direction: int  # +1: the tip grows towards larger x
+
+
 def least_stiffness(sigma_c: float, tau_c: float, GIc: float, GIIc: float) -> float:
     """max(σ_c²/(2 G_Ic), τ_c²/(2 G_IIc)) (N/mm³): a stiffer law reaches its strengths."""
     return max(sigma_c**2 / (2 * GIc), tau_c**2 / (2 * GIIc))

@@ -45,10 +45,12 @@ from sandwich.beam.contact_search import contact_pairs
 from sandwich.beam.dofs import global_dof
 from sandwich.cohesive_law import (
     CohesiveLaw,
+    CohesiveTip,
     default_shear_strength,
     default_stiffness,
     least_stiffness,
 )
+from sandwich.growth.cohesive import tip_columns
 
 #: the pair's seven DOFs: the same-x contact pair's six (PAIR_ROLES), then the face's slope
 SLOPE, CORE_SLOPE = 6, 5
@@ -59,14 +61,9 @@ GROWTH_COLUMNS = ("tip_", "process_zone_")
 
 
 @dataclass(eq=False)
-class CohesiveZone:
-    """One tip's cohesive pairs: the law, where the tip started, and the committed damage."""
+class CohesiveZone(CohesiveTip):
+    """One tip's cohesive pairs: the tip and its law, and the committed damage."""
 
-    law: CohesiveLaw
-    debond: int
-    tip: str  # "start" | "end"
-    origin: float  # the tip's x at the start of the run (mm)
-    direction: int  # +1: the tip grows towards larger x
     damage: np.ndarray  # (m, 2) committed, per pair and point (changed in place by commit)
     width: float  # the beam's width b (mm): a pair's tributary length is its area / b
 
@@ -174,28 +171,18 @@ def carry_damage(source: object, target: object, u: np.ndarray | None = None) ->
 
 
 def growth_columns(model: object) -> dict[str, float]:
-    """History columns of the committed damage: each cohesive tip's position and process zone.
+    """Each cohesive tip's position and process zone, of the committed damage.
 
-    ``tip_<debond>_<tip>``: x (mm) of the farthest fully debonded node reached from the tip's
-    origin through fully debonded nodes only (the origin itself while none is);
-    ``process_zone_<debond>_<tip>``: the length (mm) from there to the farthest damaged node.
+    The columns of :func:`sandwich.growth.cohesive.tip_columns`; a node is fully debonded
+    where both its points are.
     """
     out = {}
     for pairs in model.pairs:
-        zone = pairs.cohesive
-        if zone is None:
-            continue
-        x = model.mesh.x[pairs.nodes]
-        order = np.argsort(zone.direction * (x - zone.origin))
-        dist = zone.direction * (x[order] - zone.origin)
-        D = zone.damage[order].min(axis=1)  # fully debonded: both points
-        hurt = zone.damage[order].max(axis=1)
-        broken = np.cumprod(D >= DEBONDED).astype(bool)
-        reach = float(dist[broken].max()) if broken.any() else 0.0
-        damaged = float(dist[hurt > 0].max()) if np.any(hurt > 0) else reach
-        key = f"{zone.debond}_{zone.tip}"
-        out[f"tip_{key}"] = float(zone.origin + zone.direction * reach)
-        out[f"process_zone_{key}"] = max(damaged - reach, 0.0) + 0.0  # never −0.0
+        z = pairs.cohesive
+        if z is not None:
+            out.update(tip_columns(z.debond, z.tip, z.origin, z.direction,
+                                   model.mesh.x[pairs.nodes], z.damage.min(axis=1) >= DEBONDED,
+                                   z.damage.max(axis=1) > 0))
     return out
 
 

@@ -9,6 +9,8 @@ them (any model that writes them).
 
 from __future__ import annotations
 
+import numpy as np
+
 from sandwich.results import StepRecord
 from sandwich.scene import Scene
 
@@ -83,6 +85,27 @@ def cohesive_summary(scene: Scene, rows: list[StepRecord], element: float | None
         "tips": per_tip,
     }
     return out, warnings
+
+
+def tip_columns(debond: int, tip: str, origin: float, direction: int, x: np.ndarray,
+                broken: np.ndarray, damaged: np.ndarray) -> dict[str, float]:
+    """One cohesive tip's history columns, from its nodes' committed damage (any model).
+
+    ``x`` (mm) the nodes of the tip's span, ``broken`` whether each is fully debonded,
+    ``damaged`` whether it has any damage. ``tip_<debond>_<tip>``: x of the farthest fully
+    debonded node reached from ``origin`` through fully debonded nodes only (``origin`` while
+    none is); ``process_zone_<debond>_<tip>``: the length (mm) from there to the farthest
+    damaged node.
+    """
+    order = np.argsort(direction * (x - origin))
+    dist = direction * (x[order] - origin)
+    reached = np.cumprod(broken[order]).astype(bool)
+    reach = float(dist[reached].max()) if reached.any() else 0.0
+    hurt = damaged[order]
+    far = float(dist[hurt].max()) if hurt.any() else reach
+    key = f"{debond}_{tip}"
+    return {f"tip_{key}": float(origin + direction * reach),
+            f"process_zone_{key}": max(far - reach, 0.0) + 0.0}  # never −0.0
 
 
 def process_zone_warnings(entry: dict[str, object], element: float, more: str) -> list[str]:

@@ -38,7 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sandwich.cohesive_law import CohesiveLaw
+from sandwich.cohesive_law import CohesiveLaw, CohesiveTip
+from sandwich.growth.cohesive import tip_columns
 from sandwich.plane2d.contact import (
     CHORD_MAP,
     JUMP_MAP,
@@ -51,14 +52,9 @@ DEBONDED = 1.0 - 1e-9
 
 
 @dataclass(eq=False)
-class CohesiveLips:
-    """One tip's cohesive nodes on a debond's lips: the law, the nodes and their damage."""
+class CohesiveLips(CohesiveTip):
+    """One tip's cohesive nodes on a debond's lips: the tip and its law, the nodes, the damage."""
 
-    law: CohesiveLaw
-    debond: int
-    tip: str  # "start" | "end"
-    origin: float  # the tip's x at the start of the run (mm)
-    direction: int  # +1: the tip grows towards larger x
     slaves: np.ndarray  # (m,) positions in the pair's slave list
     weight: np.ndarray  # (m,) Simpson weights over the span (mm)
     x: np.ndarray  # (m,) reference x of the nodes (mm)
@@ -150,24 +146,14 @@ def evaluate(pair, lips: CohesiveLips, x_ref: np.ndarray, u: np.ndarray,
 
 
 def growth_columns(lips_list: list[CohesiveLips]) -> dict[str, float]:
-    """History columns of the committed damage: each cohesive tip's position and process zone.
+    """Each cohesive tip's position and process zone, of the committed damage.
 
-    ``tip_<debond>_<tip>``: x (mm) of the farthest fully debonded node reached from the tip's
-    origin through fully debonded nodes only (the origin itself while none is);
-    ``process_zone_<debond>_<tip>``: the length (mm) from there to the farthest damaged node.
-    The beam's columns (:func:`sandwich.beam.cohesive.growth_columns`).
+    The columns of :func:`sandwich.growth.cohesive.tip_columns`, as the beam's.
     """
     out = {}
-    for lips in lips_list:
-        order = np.argsort(lips.direction * (lips.x - lips.origin))
-        dist = lips.direction * (lips.x[order] - lips.origin)
-        D = lips.damage[order]
-        broken = np.cumprod(D >= DEBONDED).astype(bool)
-        reach = float(dist[broken].max()) if broken.any() else 0.0
-        damaged = float(dist[D > 0].max()) if np.any(D > 0) else reach
-        key = f"{lips.debond}_{lips.tip}"
-        out[f"tip_{key}"] = float(lips.origin + lips.direction * reach)
-        out[f"process_zone_{key}"] = max(damaged - reach, 0.0) + 0.0  # never −0.0
+    for z in lips_list:
+        out.update(tip_columns(z.debond, z.tip, z.origin, z.direction, z.x,
+                               z.damage >= DEBONDED, z.damage > 0))
     return out
 
 
