@@ -151,3 +151,24 @@ def test_undamaged_cohesive_lips_are_the_bonded_interface():
     assert a.extra["debond_growth"]["first_growth_load"] is None
     change = a.history[-1].load_factor / b.history[-1].load_factor - 1.0
     assert -0.005 < change < 0.0  # the law's compliance 1/K, as in the beam
+
+
+@pytest.mark.heavy
+def test_medium_level_follows_the_closed_form_and_the_beam():
+    """The 2D cantilever at medium (the default level) while its tip runs from 55 to 105 mm.
+
+    References: the closed-form propagation load (within the issue's 3 %) and the beam's
+    residual strength (the other model, within 5 %).
+    """
+    from sandwich.beam.solve import run
+    from sandwich.plane2d.solve import solve
+
+    sc = cohesive_cantilever()
+    sol = solve(dataclasses.replace(sc, analysis=dataclasses.replace(sc.analysis, max_steps=400)),
+                level="medium", estimate=False)
+    rows = [r for r in sol.history if 55.0 <= r.extra["tip_0_end"] <= 105.0]
+    assert len(rows) >= 10
+    ratio = np.array([r.load_factor / propagation_load(r.probes["w0"]) for r in rows])
+    assert np.all(np.abs(ratio - 1.0) < 0.03), ratio
+    beam = run(sc).solution.extra["debond_growth"]["residual_strength"]
+    assert sol.extra["debond_growth"]["residual_strength"] == pytest.approx(beam, rel=0.05)
